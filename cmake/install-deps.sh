@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs from Debian 12 whatever the project needs and is missing; does nothing when all is there.
+# Usage: cmake/install-deps.sh            (needs root or sudo only when something is missing)
+set -euo pipefail
+
+packages=(
+  g++ cmake ninja-build pkg-config    # toolchain
+  clang libclang-rt-14-dev             # clang with libFuzzer and the sanitizer runtimes
+  catch2 libfmt-dev libbenchmark-dev   # tests, formatters, micro-benchmarks
+  libboost1.81-dev                     # Boost.Asio for transport/ (1.74's Asio breaks under GCC 12 in C++20)
+  gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib  # firmware cross-compile check of the codec
+  python3                              # a client in another language for the virtual board tests
+  ser2net                              # TCP bridge used by the transport tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if [ "$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null)" != "install ok installed" ]; then
+    # python3 may come from elsewhere (pyenv); a working interpreter is enough.
+    if [ "$p" = python3 ] && command -v python3 >/dev/null 2>&1; then continue; fi
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "rcb4: installing missing packages: ${missing[*]}"
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then
+    sudo="sudo"
+  else
+    echo "rcb4: not root and no sudo; install these by hand: ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+# An empty or stale package list finds nothing; refresh it once.
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,117 @@
+// rcb4 — error codes of the codec, registered with <system_error>.
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <system_error>
+
+namespace rcb4 {
+
+/**
+ * Everything the codec can reject. Zero is "no error"; every other value has a message
+ * (see message()). constexpr code uses the enum directly; std::error_code interop is below.
+ */
+enum class errc : std::uint8_t {
+  // framing (protocol.md §2)
+  buffer_too_small = 1,   ///< the caller's output buffer cannot hold the frame
+  frame_too_short,        ///< SIZE byte below the 3-byte minimum of a frame
+  frame_too_long,         ///< request over 128 bytes (DOC-FW "COM"), reply data over 252 bytes
+  bad_frame_size,         ///< SIZE byte does not match the layout of the command
+  bad_checksum,           ///< SUM byte is not the low byte of the sum of the preceding bytes
+  unknown_command,        ///< CMD byte is not an RCB-4 command
+  bad_type_byte,          ///< MOV/ALU TYPE byte with reserved bits set or a kind this command forbids
+  reserved_bits_set,      ///< a must-be-zero byte or bit of the layout is not zero
+  // value ranges (protocol.md §4–§6)
+  ics_out_of_range,           ///< ICS number not in 0–35
+  ram_address_out_of_range,   ///< RAM range leaves 0x0000–0x048F
+  rom_address_out_of_range,   ///< ROM range leaves 0x000000–0x03FFFF
+  ics_offset_out_of_range,    ///< ICS offset + size runs past 255
+  transfer_size_out_of_range, ///< MOV/logic size not in 1–128
+  literal_size_out_of_range,  ///< literal source not in 1–121 bytes (frame ≤ 128)
+  operand_size_out_of_range,  ///< arithmetic operand not 1 or 2 bytes (DOC-CMD 四則演算)
+  ics_length_out_of_range,    ///< ICS 0x0E transmit length not in 1–64
+  position_out_of_range,      ///< servo position not in 0–16383 nor FREE/HOLD
+  param_out_of_range,         ///< speed/stretch parameter not in 1–127
+  frames_out_of_range,        ///< interpolation frames not in 0–255
+  shift_count_out_of_range,   ///< shift count not in −127…127
+  servo_id_out_of_range,      ///< servo ID/SIO pair outside ICS 0–35
+  motion_out_of_range,        ///< motion number outside the layout profile's slots
+  empty_servo_set,            ///< a multi-servo command with no servo selected
+  bad_condition,              ///< JUMP/CALL condition byte with reserved or orphan bits
+  unknown_parameter_kind,     ///< 0x12 SUB byte other than 1 (stretch) or 2 (speed)
+  // command rules (protocol.md §4.2, §11)
+  destination_not_allowed,    ///< logic/NOT/SHIFT to COM, or arithmetic to COM without opt-in
+  flags_only_not_allowed,     ///< S (flags-only) bit on MOV
+  // replies (protocol.md §2.2)
+  bad_reply_length,     ///< reply length byte is neither the expected length nor 4 (NACK)
+  echo_mismatch,        ///< reply CMD byte is not the command that was sent
+  bad_ack_code,         ///< 4-byte reply whose status byte is neither 06 (ACK) nor 15 (NACK)
+  unexpected_ack,       ///< ACK where a data reply was expected
+  nack,                 ///< the board answered NACK (mapped by the transport where an ACK was due)
+};
+
+/** A short English description of @p e, for logs and exceptions. */
+constexpr const char* message(errc e) noexcept {
+  if (e == errc{}) return "success";
+  switch (e) {
+    case errc::buffer_too_small: return "output buffer too small for the frame";
+    case errc::frame_too_short: return "frame size byte below 3";
+    case errc::frame_too_long: return "frame longer than the board accepts (requests <= 128 bytes)";
+    case errc::bad_frame_size: return "frame size byte does not match the command layout";
+    case errc::bad_checksum: return "checksum mismatch";
+    case errc::unknown_command: return "unknown command byte";
+    case errc::bad_type_byte: return "invalid TYPE byte (reserved bits or forbidden kind)";
+    case errc::reserved_bits_set: return "reserved byte or bit is not zero";
+    case errc::ics_out_of_range: return "ICS number out of range 0-35";
+    case errc::ram_address_out_of_range: return "RAM range outside 0x0000-0x048F";
+    case errc::rom_address_out_of_range: return "ROM range outside 0x000000-0x03FFFF";
+    case errc::ics_offset_out_of_range: return "ICS offset + size past 255";
+    case errc::transfer_size_out_of_range: return "transfer size out of range 1-128";
+    case errc::literal_size_out_of_range: return "literal size out of range 1-121";
+    case errc::operand_size_out_of_range: return "arithmetic operand size must be 1 or 2 bytes";
+    case errc::ics_length_out_of_range: return "ICS transmit length out of range 1-64";
+    case errc::position_out_of_range: return "servo position out of range 0-16383 (or FREE/HOLD)";
+    case errc::param_out_of_range: return "servo speed/stretch parameter out of range 1-127";
+    case errc::frames_out_of_range: return "interpolation frames out of range 0-255";
+    case errc::shift_count_out_of_range: return "shift count out of range -127..127";
+    case errc::servo_id_out_of_range: return "servo ID / SIO side outside ICS 0-35";
+    case errc::motion_out_of_range: return "motion number outside the layout's slots";
+    case errc::empty_servo_set: return "no servo selected";
+    case errc::bad_condition: return "invalid JUMP/CALL condition byte";
+    case errc::unknown_parameter_kind: return "servo parameter kind must be 1 (stretch) or 2 (speed)";
+    case errc::destination_not_allowed: return "destination not allowed for this command";
+    case errc::flags_only_not_allowed: return "flags-only (S) bit not allowed on MOV";
+    case errc::bad_reply_length: return "reply length byte unexpected";
+    case errc::echo_mismatch: return "reply echoes a different command";
+    case errc::bad_ack_code: return "reply status byte neither ACK (06) nor NACK (15)";
+    case errc::unexpected_ack: return "ACK received where data was expected";
+    case errc::nack: return "board answered NACK";
+  }
+  return "unknown rcb4 error";
+}
+
+/** The std::error_category of rcb4::errc; its name() is "rcb4". */
+class error_category_impl final : public std::error_category {
+ public:
+  /** The category name, "rcb4". */
+  const char* name() const noexcept override { return "rcb4"; }
+  /** The message of the errc value @p ev. */
+  std::string message(int ev) const override { return rcb4::message(static_cast<errc>(ev)); }
+};
+
+/** The single instance of the rcb4 error category. */
+inline const std::error_category& error_category() noexcept {
+  static const error_category_impl instance;
+  return instance;
+}
+
+/** Makes a std::error_code from @p e (found by ADL for `std::error_code ec = errc::...`). */
+inline std::error_code make_error_code(errc e) noexcept {
+  return {static_cast<int>(e), error_category()};
+}
+
+}  // namespace rcb4
+
+template <>
+struct std::is_error_code_enum<rcb4::errc> : std::true_type {};
