@@ -5,7 +5,8 @@ set -euo pipefail
 
 packages=(
   g++ cmake ninja-build pkg-config    # toolchain
-  clang libclang-rt-14-dev             # clang with libFuzzer and the sanitizer runtimes
+  clang-16 libclang-rt-16-dev          # clang with libFuzzer and sanitizers (clang 14 crashes on consteval)
+  clang-format                         # formatting (.clang-format)
   catch2 libfmt-dev libbenchmark-dev   # tests, formatters, micro-benchmarks
   libboost1.81-dev                     # Boost.Asio for transport/ (1.74's Asio breaks under GCC 12 in C++20)
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib  # firmware cross-compile check of the codec

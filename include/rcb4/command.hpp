@@ -18,8 +18,8 @@
 namespace rcb4 {
 
 /** Any RCB-4 command. Every alternative satisfies rcb4::Command. */
-using command = std::variant<ping, version, move, logic, bit_not, shift, arith, jump, call, ret,
-                             ics_exchange, single_servo, const_servo, series_servo, servo_params>;
+using command = std::variant<ping, version, move, logic, bit_not, shift, arith, jump, call, ret, ics_exchange,
+                             single_servo, const_servo, series_servo, servo_params>;
 
 /** The frame length of @p c. */
 template <Command C>
@@ -60,7 +60,7 @@ constexpr result<std::size_t> serialize(const command& c, std::span<std::uint8_t
 
 /** The frame of @p c in a 128-byte inline buffer (every command fits). */
 template <class C>
-  requires Command<C> || std::same_as<C, command>
+requires Command<C> || std::same_as<C, command>
 constexpr request_frame encode(const C& c) noexcept {
   request_frame f;
   const auto n = serialize(c, f.storage());
@@ -71,19 +71,26 @@ constexpr request_frame encode(const C& c) noexcept {
 /** Frame length of commands whose length never varies; 0 for the others. */
 template <class C>
 inline constexpr std::size_t fixed_wire_size = 0;
-template <> inline constexpr std::size_t fixed_wire_size<version> = 3;
-template <> inline constexpr std::size_t fixed_wire_size<ret> = 3;
-template <> inline constexpr std::size_t fixed_wire_size<jump> = 7;
-template <> inline constexpr std::size_t fixed_wire_size<call> = 7;
-template <> inline constexpr std::size_t fixed_wire_size<single_servo> = 7;
-template <> inline constexpr std::size_t fixed_wire_size<ics_exchange> = 9;
-template <> inline constexpr std::size_t fixed_wire_size<bit_not> = 10;
-template <> inline constexpr std::size_t fixed_wire_size<shift> = 10;
+template <>
+inline constexpr std::size_t fixed_wire_size<version> = 3;
+template <>
+inline constexpr std::size_t fixed_wire_size<ret> = 3;
+template <>
+inline constexpr std::size_t fixed_wire_size<jump> = 7;
+template <>
+inline constexpr std::size_t fixed_wire_size<call> = 7;
+template <>
+inline constexpr std::size_t fixed_wire_size<single_servo> = 7;
+template <>
+inline constexpr std::size_t fixed_wire_size<ics_exchange> = 9;
+template <>
+inline constexpr std::size_t fixed_wire_size<bit_not> = 10;
+template <>
+inline constexpr std::size_t fixed_wire_size<shift> = 10;
 
 /** The frame of a fixed-length command as a std::array of exactly its length. */
 template <Command C>
-  requires(fixed_wire_size<C> != 0)
-constexpr std::array<std::uint8_t, fixed_wire_size<C>> to_array(const C& c) noexcept {
+requires(fixed_wire_size<C> != 0) constexpr std::array<std::uint8_t, fixed_wire_size<C>> to_array(const C& c) noexcept {
   std::array<std::uint8_t, fixed_wire_size<C>> out{};
   (void)serialize(c, out);  // the size is exact by construction
   return out;
@@ -92,14 +99,16 @@ constexpr std::array<std::uint8_t, fixed_wire_size<C>> to_array(const C& c) noex
 namespace detail {
 template <class T>
 constexpr bool accepts_code(std::uint8_t code) noexcept {
-  if constexpr (std::same_as<T, logic>) return code >= 0x01 && code <= 0x03;
-  else if constexpr (std::same_as<T, arith>) return code >= 0x06 && code <= 0x0A;
-  else return code == T::command_code;
+  if constexpr (std::same_as<T, logic>)
+    return code >= 0x01 && code <= 0x03;
+  else if constexpr (std::same_as<T, arith>)
+    return code >= 0x06 && code <= 0x0A;
+  else
+    return code == T::command_code;
 }
 
 template <std::size_t I = 0>
-constexpr result<command> parse_alternative(std::span<const std::uint8_t> frame,
-                                            const codec_options& opt) noexcept {
+constexpr result<command> parse_alternative(std::span<const std::uint8_t> frame, const codec_options& opt) noexcept {
   if constexpr (I == std::variant_size_v<command>) {
     return errc::unknown_command;
   } else {

@@ -14,41 +14,41 @@ namespace rcb4 {
  */
 enum class errc : std::uint8_t {
   // framing (protocol.md §2)
-  buffer_too_small = 1,   ///< the caller's output buffer cannot hold the frame
-  frame_too_short,        ///< SIZE byte below the 3-byte minimum of a frame
-  frame_too_long,         ///< request over 128 bytes (DOC-FW "COM"), reply data over 252 bytes
-  bad_frame_size,         ///< SIZE byte does not match the layout of the command
-  bad_checksum,           ///< SUM byte is not the low byte of the sum of the preceding bytes
-  unknown_command,        ///< CMD byte is not an RCB-4 command
-  bad_type_byte,          ///< MOV/ALU TYPE byte with reserved bits set or a kind this command forbids
-  reserved_bits_set,      ///< a must-be-zero byte or bit of the layout is not zero
+  buffer_too_small = 1,  ///< the caller's output buffer cannot hold the frame
+  frame_too_short,       ///< SIZE byte below the 3-byte minimum of a frame
+  frame_too_long,        ///< request over 128 bytes (DOC-FW "COM"), reply data over 252 bytes
+  bad_frame_size,        ///< SIZE byte does not match the layout of the command
+  bad_checksum,          ///< SUM byte is not the low byte of the sum of the preceding bytes
+  unknown_command,       ///< CMD byte is not an RCB-4 command
+  bad_type_byte,         ///< MOV/ALU TYPE byte with reserved bits set or a kind this command forbids
+  reserved_bits_set,     ///< a must-be-zero byte or bit of the layout is not zero
   // value ranges (protocol.md §4–§6)
-  ics_out_of_range,           ///< ICS number not in 0–35
-  ram_address_out_of_range,   ///< RAM range leaves 0x0000–0x048F
-  rom_address_out_of_range,   ///< ROM range leaves 0x000000–0x03FFFF
-  ics_offset_out_of_range,    ///< ICS offset + size runs past 255
-  transfer_size_out_of_range, ///< MOV/logic size not in 1–128
-  literal_size_out_of_range,  ///< literal source not in 1–121 bytes (frame ≤ 128)
-  operand_size_out_of_range,  ///< arithmetic operand not 1 or 2 bytes (DOC-CMD 四則演算)
-  ics_length_out_of_range,    ///< ICS 0x0E transmit length not in 1–64
-  position_out_of_range,      ///< servo position not in 0–16383 nor FREE/HOLD
-  param_out_of_range,         ///< speed/stretch parameter not in 1–127
-  frames_out_of_range,        ///< interpolation frames not in 0–255
-  shift_count_out_of_range,   ///< shift count not in −127…127
-  servo_id_out_of_range,      ///< servo ID/SIO pair outside ICS 0–35
-  motion_out_of_range,        ///< motion number outside the layout profile's slots
-  empty_servo_set,            ///< a multi-servo command with no servo selected
-  bad_condition,              ///< JUMP/CALL condition byte with reserved or orphan bits
-  unknown_parameter_kind,     ///< 0x12 SUB byte other than 1 (stretch) or 2 (speed)
+  ics_out_of_range,            ///< ICS number not in 0–35
+  ram_address_out_of_range,    ///< RAM range leaves 0x0000–0x048F
+  rom_address_out_of_range,    ///< ROM range leaves 0x000000–0x03FFFF
+  ics_offset_out_of_range,     ///< ICS offset + size runs past 255
+  transfer_size_out_of_range,  ///< MOV/logic size not in 1–128
+  literal_size_out_of_range,   ///< literal source not in 1–121 bytes (frame ≤ 128)
+  operand_size_out_of_range,   ///< arithmetic operand not 1 or 2 bytes (DOC-CMD 四則演算)
+  ics_length_out_of_range,     ///< ICS 0x0E transmit length not in 1–64
+  position_out_of_range,       ///< servo position not in 0–16383 nor FREE/HOLD
+  param_out_of_range,          ///< speed/stretch parameter not in 1–127
+  frames_out_of_range,         ///< interpolation frames not in 0–255
+  shift_count_out_of_range,    ///< shift count not in −127…127
+  servo_id_out_of_range,       ///< servo ID/SIO pair outside ICS 0–35
+  motion_out_of_range,         ///< motion number outside the layout profile's slots
+  empty_servo_set,             ///< a multi-servo command with no servo selected
+  bad_condition,               ///< JUMP/CALL condition byte with reserved or orphan bits
+  unknown_parameter_kind,      ///< 0x12 SUB byte other than 1 (stretch) or 2 (speed)
   // command rules (protocol.md §4.2, §11)
-  destination_not_allowed,    ///< logic/NOT/SHIFT to COM, or arithmetic to COM without opt-in
-  flags_only_not_allowed,     ///< S (flags-only) bit on MOV
+  destination_not_allowed,  ///< logic/NOT/SHIFT to COM, or arithmetic to COM without opt-in
+  flags_only_not_allowed,   ///< S (flags-only) bit on MOV
   // replies (protocol.md §2.2)
-  bad_reply_length,     ///< reply length byte is neither the expected length nor 4 (NACK)
-  echo_mismatch,        ///< reply CMD byte is not the command that was sent
-  bad_ack_code,         ///< 4-byte reply whose status byte is neither 06 (ACK) nor 15 (NACK)
-  unexpected_ack,       ///< ACK where a data reply was expected
-  nack,                 ///< the board answered NACK (mapped by the transport where an ACK was due)
+  bad_reply_length,  ///< reply length byte is neither the expected length nor 4 (NACK)
+  echo_mismatch,     ///< reply CMD byte is not the command that was sent
+  bad_ack_code,      ///< 4-byte reply whose status byte is neither 06 (ACK) nor 15 (NACK)
+  unexpected_ack,    ///< ACK where a data reply was expected
+  nack,              ///< the board answered NACK (mapped by the transport where an ACK was due)
 };
 
 /** A short English description of @p e, for logs and exceptions. */
@@ -107,9 +107,7 @@ inline const std::error_category& error_category() noexcept {
 }
 
 /** Makes a std::error_code from @p e (found by ADL for `std::error_code ec = errc::...`). */
-inline std::error_code make_error_code(errc e) noexcept {
-  return {static_cast<int>(e), error_category()};
-}
+inline std::error_code make_error_code(errc e) noexcept { return {static_cast<int>(e), error_category()}; }
 
 }  // namespace rcb4
 

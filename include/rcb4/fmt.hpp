@@ -52,9 +52,18 @@ constexpr std::string_view command_name(std::uint8_t code) noexcept {
 }
 
 namespace fmt_detail {
-/** Formatters without format options. */
-struct plain {
-  constexpr auto parse(fmt::format_parse_context& ctx) { return ctx.begin(); }
+/**
+ * Base of the rcb4 formatters: Derived::write renders the value, then the standard string
+ * specs apply (width, fill, alignment: "{:<40}").
+ */
+template <class Derived, class T>
+struct padded : fmt::formatter<std::string_view> {
+  template <class Ctx>
+  auto format(const T& value, Ctx& ctx) const {
+    fmt::memory_buffer buf;
+    Derived::write(fmt::appender(buf), value);
+    return fmt::formatter<std::string_view>::format(std::string_view(buf.data(), buf.size()), ctx);
+  }
 };
 
 template <class Out>
@@ -101,10 +110,10 @@ constexpr std::string_view update_suffix(update_flags f) noexcept {
 }  // namespace rcb4
 
 template <>
-struct fmt::formatter<rcb4::hex_view> : rcb4::fmt_detail::plain {
-  template <class Ctx>
-  auto format(const rcb4::hex_view& h, Ctx& ctx) const {
-    auto out = ctx.out();
+struct fmt::formatter<rcb4::hex_view> : rcb4::fmt_detail::padded<fmt::formatter<rcb4::hex_view>, rcb4::hex_view> {
+  template <class Out>
+  static Out write(Out out_, const rcb4::hex_view& h) {
+    auto out = out_;
     bool first = true;
     for (auto b : h.bytes) {
       if (!first) *out++ = ' ';
@@ -116,20 +125,20 @@ struct fmt::formatter<rcb4::hex_view> : rcb4::fmt_detail::plain {
 };
 
 template <>
-struct fmt::formatter<rcb4::errc> : rcb4::fmt_detail::plain {
-  template <class Ctx>
-  auto format(rcb4::errc e, Ctx& ctx) const {
-    return fmt::format_to(ctx.out(), "{}", rcb4::message(e));
+struct fmt::formatter<rcb4::errc> : rcb4::fmt_detail::padded<fmt::formatter<rcb4::errc>, rcb4::errc> {
+  template <class Out>
+  static Out write(Out out_, rcb4::errc e) {
+    return fmt::format_to(out_, "{}", rcb4::message(e));
   }
 };
 
 template <>
-struct fmt::formatter<rcb4::command> : rcb4::fmt_detail::plain {
-  template <class Ctx>
-  auto format(const rcb4::command& c, Ctx& ctx) const {
+struct fmt::formatter<rcb4::command> : rcb4::fmt_detail::padded<fmt::formatter<rcb4::command>, rcb4::command> {
+  template <class Out>
+  static Out write(Out out_, const rcb4::command& c) {
     using namespace rcb4;
     using namespace rcb4::fmt_detail;
-    auto out = ctx.out();
+    auto out = out_;
     return std::visit(
         [&](const auto& x) {
           using T = std::decay_t<decltype(x)>;
@@ -156,8 +165,7 @@ struct fmt::formatter<rcb4::command> : rcb4::fmt_detail::plain {
             out = fmt::format_to(out, "SHIFT ");
             out = write_dst(out, x.dst(), x.size().value());
             const int n = x.count().value();
-            return fmt::format_to(out, " {} {}{}", n >= 0 ? "left" : "right", n >= 0 ? n : -n,
-                                  flags_suffix(x.mode()));
+            return fmt::format_to(out, " {} {}{}", n >= 0 ? "left" : "right", n >= 0 ? n : -n, flags_suffix(x.mode()));
           } else if constexpr (std::is_same_v<T, jump> || std::is_same_v<T, call>) {
             out = fmt::format_to(out, "{} 0x{:06X}", command_name(x.code()), x.target().value());
             return write_cond(out, x.cond());
@@ -198,31 +206,31 @@ struct fmt::formatter<rcb4::command> : rcb4::fmt_detail::plain {
 };
 
 template <>
-struct fmt::formatter<rcb4::reply> : rcb4::fmt_detail::plain {
-  template <class Ctx>
-  auto format(const rcb4::reply& r, Ctx& ctx) const {
+struct fmt::formatter<rcb4::reply> : rcb4::fmt_detail::padded<fmt::formatter<rcb4::reply>, rcb4::reply> {
+  template <class Out>
+  static Out write(Out out_, const rcb4::reply& r) {
     const auto name = rcb4::command_name(r.command());
     switch (r.kind()) {
-      case rcb4::reply_kind::ack: return fmt::format_to(ctx.out(), "ACK to {}", name);
-      case rcb4::reply_kind::nack: return fmt::format_to(ctx.out(), "NACK to {}", name);
+      case rcb4::reply_kind::ack: return fmt::format_to(out_, "ACK to {}", name);
+      case rcb4::reply_kind::nack: return fmt::format_to(out_, "NACK to {}", name);
       case rcb4::reply_kind::data: break;
     }
-    return fmt::format_to(ctx.out(), "DATA from {}, {} bytes: {}", name, r.bytes().size(), rcb4::hex(r.bytes()));
+    return fmt::format_to(out_, "DATA from {}, {} bytes: {}", name, r.bytes().size(), rcb4::hex(r.bytes()));
   }
 };
 
 template <>
-struct fmt::formatter<rcb4::config_word> : rcb4::fmt_detail::plain {
-  template <class Ctx>
-  auto format(const rcb4::config_word& c, Ctx& ctx) const {
+struct fmt::formatter<rcb4::config_word>
+    : rcb4::fmt_detail::padded<fmt::formatter<rcb4::config_word>, rcb4::config_word> {
+  template <class Out>
+  static Out write(Out out_, const rcb4::config_word& c) {
     using namespace rcb4;
-    return fmt::format_to(ctx.out(),
+    return fmt::format_to(out_,
                           "0x{:04X}: ICS {}, ROM program {}, interpolation message {}, vector jump {}, "
                           "period {} ms, COM {} baud, ICS {} baud, Z={} C={}, program error {}, LED {}",
                           c.encode(), c.ics_enabled ? "on" : "off", c.rom_program ? "on" : "off",
-                          c.interpolation_message ? "on" : "off", c.vector_jump ? "on" : "off",
-                          milliseconds(c.period), bits_per_second(c.com_baud), bits_per_second(c.ics_baud),
-                          c.zero_flag ? 1 : 0, c.carry_flag ? 1 : 0, c.program_error ? "yes" : "no",
-                          c.led ? "on" : "off");
+                          c.interpolation_message ? "on" : "off", c.vector_jump ? "on" : "off", milliseconds(c.period),
+                          bits_per_second(c.com_baud), bits_per_second(c.ics_baud), c.zero_flag ? 1 : 0,
+                          c.carry_flag ? 1 : 0, c.program_error ? "yes" : "no", c.led ? "on" : "off");
   }
 };

@@ -13,13 +13,13 @@
 
 namespace rcb4 {
 
-inline constexpr std::size_t min_frame_size = 3;      ///< [SIZE][CMD][SUM]
-inline constexpr std::size_t max_request_size = 128;  ///< the board's receive limit (DOC-FW "COM")
-inline constexpr std::size_t max_reply_size = 255;    ///< largest SIZE byte
+inline constexpr std::size_t min_frame_size = 3;                   ///< [SIZE][CMD][SUM]
+inline constexpr std::size_t max_request_size = 128;               ///< the board's receive limit (DOC-FW "COM")
+inline constexpr std::size_t max_reply_size = 255;                 ///< largest SIZE byte
 inline constexpr std::size_t max_reply_data = max_reply_size - 3;  ///< data bytes in a reply
-inline constexpr std::size_t ack_frame_size = 4;      ///< [04][CMD][06|15][SUM]
-inline constexpr std::uint8_t ack_code = 0x06;        ///< ACK status byte
-inline constexpr std::uint8_t nack_code = 0x15;       ///< NACK status byte
+inline constexpr std::size_t ack_frame_size = 4;                   ///< [04][CMD][06|15][SUM]
+inline constexpr std::uint8_t ack_code = 0x06;                     ///< ACK status byte
+inline constexpr std::uint8_t nack_code = 0x15;                    ///< NACK status byte
 
 /** Low byte of the sum of @p bytes: the SUM of a frame over everything before it (§2.1). */
 constexpr std::uint8_t checksum(std::span<const std::uint8_t> bytes) noexcept {
@@ -102,8 +102,10 @@ class writer {
  public:
   constexpr explicit writer(std::span<std::uint8_t> out) noexcept : out_(out) {}
   constexpr void u8(std::uint8_t b) noexcept {
-    if (pos_ < out_.size()) out_[pos_] = b;
-    else overflow_ = true;
+    if (pos_ < out_.size())
+      out_[pos_] = b;
+    else
+      overflow_ = true;
     ++pos_;
   }
   constexpr void u16(std::uint16_t v) noexcept {  // little-endian

@@ -16,23 +16,23 @@ namespace rcb4 {
 
 /** Named RAM addresses (protocol.md §6). */
 namespace ram {
-inline constexpr ram_address config{0x0000};          ///< system/config register (2 bytes)
-inline constexpr ram_address program_counter{0x0002}; ///< ROM program counter (3 bytes, LE)
-inline constexpr ram_address stack_pointer{0x0005};   ///< call-stack counter (1 byte, do not write)
-inline constexpr ram_address update_flags{0x0007};    ///< EEPROM update flags (5 bytes)
-inline constexpr ram_address ad_reference{0x000C};    ///< AD k reference at +2k, k = 0..10
-inline constexpr ram_address ad_value{0x0022};        ///< AD k measured value at +2k (raw − reference)
-inline constexpr ram_address pio_direction{0x0038};   ///< bit n = PIO n+1 is an output (power-on 0x03FF)
-inline constexpr ram_address pio_value{0x003A};       ///< PIO levels, 10 bits
-inline constexpr ram_address timer{0x003C};           ///< down-timer k at +2k, k = 0..3 (100 ms ticks)
-inline constexpr ram_address ics_allocation{0x0044};  ///< ICS k servo block address at +2k (0xFFFF none)
-inline constexpr ram_address vector_table{0x008C};    ///< jump-vector table address
-inline constexpr ram_address user_area{0x0090};       ///< first byte of the user area
+inline constexpr ram_address config{0x0000};           ///< system/config register (2 bytes)
+inline constexpr ram_address program_counter{0x0002};  ///< ROM program counter (3 bytes, LE)
+inline constexpr ram_address stack_pointer{0x0005};    ///< call-stack counter (1 byte, do not write)
+inline constexpr ram_address update_flags{0x0007};     ///< EEPROM update flags (5 bytes)
+inline constexpr ram_address ad_reference{0x000C};     ///< AD k reference at +2k, k = 0..10
+inline constexpr ram_address ad_value{0x0022};         ///< AD k measured value at +2k (raw − reference)
+inline constexpr ram_address pio_direction{0x0038};    ///< bit n = PIO n+1 is an output (power-on 0x03FF)
+inline constexpr ram_address pio_value{0x003A};        ///< PIO levels, 10 bits
+inline constexpr ram_address timer{0x003C};            ///< down-timer k at +2k, k = 0..3 (100 ms ticks)
+inline constexpr ram_address ics_allocation{0x0044};   ///< ICS k servo block address at +2k (0xFFFF none)
+inline constexpr ram_address vector_table{0x008C};     ///< jump-vector table address
+inline constexpr ram_address user_area{0x0090};        ///< first byte of the user area
 
-inline constexpr std::uint8_t ad_channels = 11;        ///< AD0 (supply/5) … AD10
-inline constexpr std::uint8_t timers = 4;              ///< down-timers 0–3
-inline constexpr std::uint16_t timer_stopped = 0x8000; ///< bit 15 of a timer: stopped (power-on value)
-inline constexpr std::uint16_t no_allocation = 0xFFFF; ///< allocation entry of an unused ICS slot
+inline constexpr std::uint8_t ad_channels = 11;         ///< AD0 (supply/5) … AD10
+inline constexpr std::uint8_t timers = 4;               ///< down-timers 0–3
+inline constexpr std::uint16_t timer_stopped = 0x8000;  ///< bit 15 of a timer: stopped (power-on value)
+inline constexpr std::uint16_t no_allocation = 0xFFFF;  ///< allocation entry of an unused ICS slot
 
 /** AD channel @p k's measured value (k 0..10). */
 constexpr result<ram_address> ad(unsigned k) noexcept {
@@ -82,18 +82,18 @@ constexpr result<baud_code> baud_code_of(std::uint32_t bps) noexcept {
  * decode(encode()) and encode(decode(w)) are identities for every 16-bit word.
  */
 struct config_word {
-  bool ics_enabled = false;          ///< bit 0: SIO/ICS switch, servos driven
-  bool rom_program = false;          ///< bit 1: run the EEPROM program
-  bool interpolation_message = false;///< bit 2: message on COM when interpolation ends
-  bool vector_jump = false;          ///< bit 3: vector-jump switch
+  bool ics_enabled = false;                    ///< bit 0: SIO/ICS switch, servos driven
+  bool rom_program = false;                    ///< bit 1: run the EEPROM program
+  bool interpolation_message = false;          ///< bit 2: message on COM when interpolation ends
+  bool vector_jump = false;                    ///< bit 3: vector-jump switch
   output_period period = output_period::ms10;  ///< bits 4-5
   baud_code com_baud = baud_code::b115200;     ///< bits 6-7
-  bool zero_flag = false;            ///< bit 8: Z
-  bool carry_flag = false;           ///< bit 9: C
-  bool program_error = false;        ///< bit 10: program checksum error
-  std::uint8_t unused = 0;           ///< bits 11-12, kept as read
+  bool zero_flag = false;                      ///< bit 8: Z
+  bool carry_flag = false;                     ///< bit 9: C
+  bool program_error = false;                  ///< bit 10: program checksum error
+  std::uint8_t unused = 0;                     ///< bits 11-12, kept as read
   baud_code ics_baud = baud_code::b115200;     ///< bits 13-14
-  bool led = false;                  ///< bit 15: green LED
+  bool led = false;                            ///< bit 15: green LED
 
   /** The 16-bit register value. */
   constexpr std::uint16_t encode() const noexcept {
@@ -140,20 +140,20 @@ struct servo_field {
 
 /** The servo data block's fields. */
 namespace servo_block {
-inline constexpr std::uint8_t size = 20;                  ///< bytes per ICS slot
-inline constexpr servo_field category{0, 1};              ///< 0 = servo block
-inline constexpr servo_field id{1, 1};                    ///< servo ID
-inline constexpr servo_field trim{2, 2};                  ///< reference / trim (基準値)
-inline constexpr servo_field position{4, 2};              ///< measured position = servo value − trim
-inline constexpr servo_field target{6, 2};                ///< output position written by 0x0F/0x10
-inline constexpr servo_field interp_speed{8, 1};          ///< interpolation frames
-inline constexpr servo_field interp_end{9, 2};            ///< interpolation end position
-inline constexpr servo_field interp_steps{11, 1};         ///< interpolation steps remaining
-inline constexpr servo_field interp_width{12, 2};         ///< interpolation width
-inline constexpr servo_field mix1_source{14, 2};          ///< mixing-1 source word
-inline constexpr servo_field mix1_gain{16, 1};            ///< mixing-1 gain: bit 7 sign, low bits ratio
-inline constexpr servo_field mix2_source{17, 2};          ///< mixing-2 source word
-inline constexpr servo_field mix2_gain{19, 1};            ///< mixing-2 gain
+inline constexpr std::uint8_t size = 20;           ///< bytes per ICS slot
+inline constexpr servo_field category{0, 1};       ///< 0 = servo block
+inline constexpr servo_field id{1, 1};             ///< servo ID
+inline constexpr servo_field trim{2, 2};           ///< reference / trim (基準値)
+inline constexpr servo_field position{4, 2};       ///< measured position = servo value − trim
+inline constexpr servo_field target{6, 2};         ///< output position written by 0x0F/0x10
+inline constexpr servo_field interp_speed{8, 1};   ///< interpolation frames
+inline constexpr servo_field interp_end{9, 2};     ///< interpolation end position
+inline constexpr servo_field interp_steps{11, 1};  ///< interpolation steps remaining
+inline constexpr servo_field interp_width{12, 2};  ///< interpolation width
+inline constexpr servo_field mix1_source{14, 2};   ///< mixing-1 source word
+inline constexpr servo_field mix1_gain{16, 1};     ///< mixing-1 gain: bit 7 sign, low bits ratio
+inline constexpr servo_field mix2_source{17, 2};   ///< mixing-2 source word
+inline constexpr servo_field mix2_gain{19, 1};     ///< mixing-2 gain
 /** HTH4's RAM address of ICS @p n's block, 0x0090 + 20·n (read the allocation table to be sure). */
 constexpr ram_address hth4_address(ics_number n) noexcept {
   return ram_address::make(ram::user_area.value() + size * n.value()).value();
@@ -162,9 +162,18 @@ constexpr ram_address hth4_address(ics_number n) noexcept {
 
 /** KRR/KRC receiver buttons, as bits of the button word (protocol.md §6). */
 enum class krr_button : std::uint16_t {
-  up = 0x0001, down = 0x0002, right = 0x0004, left = 0x0008,
-  triangle = 0x0010, cross = 0x0020, circle = 0x0040, square = 0x0100,
-  s1 = 0x0200, s2 = 0x0400, s3 = 0x0800, s4 = 0x1000,
+  up = 0x0001,
+  down = 0x0002,
+  right = 0x0004,
+  left = 0x0008,
+  triangle = 0x0010,
+  cross = 0x0020,
+  circle = 0x0040,
+  square = 0x0100,
+  s1 = 0x0200,
+  s2 = 0x0400,
+  s3 = 0x0800,
+  s4 = 0x1000,
 };
 
 /** The KRI-3 receiver area of HTH4 (slot 35's block, DOC-PRG). */
@@ -188,9 +197,9 @@ constexpr std::uint16_t decode_buttons(std::uint8_t first, std::uint8_t second) 
 /** HTH4 user-area items (DOC-PRG p2-5). */
 namespace hth4_ram {
 inline constexpr ram_address vector_entries{0x0357};  ///< 8-byte vector-jump entries
-inline constexpr ram_address counters{0x0457};         ///< 1 byte each; DOC-PRG/GMU: 11 counters 0–10
+inline constexpr ram_address counters{0x0457};        ///< 1 byte each; DOC-PRG/GMU: 11 counters 0–10
 inline constexpr std::uint8_t counter_count = 11;
-inline constexpr ram_address user_params{0x0462};     ///< int16 each, 20 parameters
+inline constexpr ram_address user_params{0x0462};  ///< int16 each, 20 parameters
 inline constexpr std::uint8_t user_param_count = 20;
 inline constexpr ram_address tmp1{0x048A};
 inline constexpr ram_address tmp2{0x048C};
@@ -211,13 +220,13 @@ constexpr double battery_volts(std::uint16_t ad0) noexcept { return ad0 * 25.0 /
 
 /** Where an HTH4 version puts the main loop and the motions in ROM (protocol.md §8, §11.13). */
 struct rom_layout {
-  const char* name;          ///< "HTH4 1.3", ...
-  rom_address startup;       ///< StartupCmd
-  rom_address main_loop;     ///< MainLoopCmd: the PC to reset to before a CALL
-  rom_address config;        ///< ConfigDataRom (persistent config word)
-  rom_address motion_base;   ///< motion 1
-  std::uint32_t slot_size;   ///< bytes per motion
-  std::uint8_t motion_count; ///< motions 1..count
+  const char* name;           ///< "HTH4 1.3", ...
+  rom_address startup;        ///< StartupCmd
+  rom_address main_loop;      ///< MainLoopCmd: the PC to reset to before a CALL
+  rom_address config;         ///< ConfigDataRom (persistent config word)
+  rom_address motion_base;    ///< motion 1
+  std::uint32_t slot_size;    ///< bytes per motion
+  std::uint8_t motion_count;  ///< motions 1..count
 };
 
 /** HTH4 1.3 (DOC-PRG). */

@@ -11,6 +11,8 @@
 #include <rcb4/frame.hpp>
 #include <rcb4/values.hpp>
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <span>
 
@@ -21,6 +23,14 @@ enum class dst_kind : std::uint8_t { ram = 0, ics = 1, com = 2, rom = 3 };
 /** Source kinds, as TYPE bits 1-0. */
 enum class src_kind : std::uint8_t { ram = 0, ics = 1, literal = 2, rom = 3 };
 
+namespace detail {
+// Defaults of the command types' default constructors, named here because clang 14 crashes on
+// consteval constructor calls nested in default member initializers.
+inline constexpr ram_address default_ram{0x0090};
+inline constexpr ram_address zero_ram{0x0000};
+inline constexpr transfer_size one_byte{1};
+}  // namespace detail
+
 /** The largest literal a MOV can carry: 128-byte frame minus 7 bytes of framing. */
 inline constexpr std::size_t max_literal_size = max_request_size - 7;
 
@@ -30,9 +40,7 @@ class destination {
   /** RAM at @p a. */
   static constexpr destination ram(ram_address a) noexcept { return {dst_kind::ram, a.value(), {}}; }
   /** Field @p offset of ICS slot @p n (through the board's allocation table). */
-  static constexpr destination ics(ics_number n, std::uint8_t offset) noexcept {
-    return {dst_kind::ics, offset, n};
-  }
+  static constexpr destination ics(ics_number n, std::uint8_t offset) noexcept { return {dst_kind::ics, offset, n}; }
   /** The COM port: the board replies with the data. */
   static constexpr destination com() noexcept { return {dst_kind::com, 0, {}}; }
   /** EEPROM at @p a. */
@@ -57,8 +65,15 @@ class destination {
   /** Writes the 3-byte DST field. */
   constexpr void write(detail::writer& w) const noexcept {
     switch (kind_) {
-      case dst_kind::ram: w.u16(static_cast<std::uint16_t>(address_)); w.u8(0); break;
-      case dst_kind::ics: w.u8(static_cast<std::uint8_t>(address_)); w.u8(ics_.value()); w.u8(0); break;
+      case dst_kind::ram:
+        w.u16(static_cast<std::uint16_t>(address_));
+        w.u8(0);
+        break;
+      case dst_kind::ics:
+        w.u8(static_cast<std::uint8_t>(address_));
+        w.u8(ics_.value());
+        w.u8(0);
+        break;
       case dst_kind::com: w.u24(0); break;
       case dst_kind::rom: w.u24(address_); break;
     }
@@ -97,8 +112,7 @@ class destination {
   constexpr destination() noexcept = default;
 
  private:
-  constexpr destination(dst_kind k, std::uint32_t a, ics_number n) noexcept
-      : kind_(k), address_(a), ics_(n) {}
+  constexpr destination(dst_kind k, std::uint32_t a, ics_number n) noexcept : kind_(k), address_(a), ics_(n) {}
   dst_kind kind_ = dst_kind::ram;
   std::uint32_t address_ = 0;
   ics_number ics_{};
@@ -122,22 +136,27 @@ class source {
     if (a.value() + std::size_t{size.value()} > rom_size) return errc::rom_address_out_of_range;
     return source{src_kind::rom, a.value(), {}, size.value()};
   }
-  /** The literal @p bytes (1–121) carried in the frame. */
+  /**
+   * The literal @p bytes (1–121) carried in the frame. The bytes are referenced, not copied
+   * (like std::span): keep them alive until the command is serialized.
+   */
   static constexpr result<source> literal(std::span<const std::uint8_t> bytes) noexcept {
     if (bytes.empty() || bytes.size() > max_literal_size) return errc::literal_size_out_of_range;
     source s{src_kind::literal, 0, {}, static_cast<std::uint8_t>(bytes.size())};
-    s.literal_ = byte_buffer<max_literal_size>(bytes);
+    s.external_ = bytes.data();
     return s;
   }
-  /** A 16-bit literal, little-endian (as every RCB-4 word). */
+  /** A 16-bit literal, little-endian (as every RCB-4 word); stored in the value itself. */
   static constexpr source literal_u16(std::uint16_t v) noexcept {
-    const std::uint8_t b[2] = {static_cast<std::uint8_t>(v & 0xFFu), static_cast<std::uint8_t>(v >> 8)};
-    return literal(b).value();
+    source s{src_kind::literal, 0, {}, 2};
+    s.inline_ = {static_cast<std::uint8_t>(v & 0xFFu), static_cast<std::uint8_t>(v >> 8)};
+    return s;
   }
-  /** An 8-bit literal. */
+  /** An 8-bit literal; stored in the value itself. */
   static constexpr source literal_u8(std::uint8_t v) noexcept {
-    const std::uint8_t b[1] = {v};
-    return literal(b).value();
+    source s{src_kind::literal, 0, {}, 1};
+    s.inline_ = {v, 0};
+    return s;
   }
 
   /** Which memory. */
@@ -149,7 +168,10 @@ class source {
   /** Bytes moved: the transfer size, or the literal's length. */
   constexpr std::uint8_t size() const noexcept { return size_; }
   /** The literal bytes (empty unless src_kind::literal). */
-  constexpr std::span<const std::uint8_t> literal_bytes() const noexcept { return literal_.bytes(); }
+  constexpr std::span<const std::uint8_t> literal_bytes() const noexcept {
+    if (kind_ != src_kind::literal) return {};
+    return {external_ ? external_ : inline_.data(), size_};
+  }
   /** Bytes of the SRC field on the wire. */
   constexpr std::size_t wire_size() const noexcept {
     switch (kind_) {
@@ -163,10 +185,20 @@ class source {
   /** Writes the SRC field. */
   constexpr void write(detail::writer& w) const noexcept {
     switch (kind_) {
-      case src_kind::ram: w.u16(static_cast<std::uint16_t>(address_)); w.u8(size_); break;
-      case src_kind::ics: w.u8(static_cast<std::uint8_t>(address_)); w.u8(ics_.value()); w.u8(size_); break;
-      case src_kind::rom: w.u24(address_); w.u8(size_); break;
-      case src_kind::literal: w.bytes(literal_.bytes()); break;
+      case src_kind::ram:
+        w.u16(static_cast<std::uint16_t>(address_));
+        w.u8(size_);
+        break;
+      case src_kind::ics:
+        w.u8(static_cast<std::uint8_t>(address_));
+        w.u8(ics_.value());
+        w.u8(size_);
+        break;
+      case src_kind::rom:
+        w.u24(address_);
+        w.u8(size_);
+        break;
+      case src_kind::literal: w.bytes(literal_bytes()); break;
     }
   }
   /** Reads a SRC field of kind @p k from the rest of @p r (the literal takes all of it). */
@@ -195,8 +227,14 @@ class source {
     if (!s) return s.error();
     return rom(*a, *s);
   }
-  friend constexpr bool operator==(const source&, const source&) noexcept = default;
+  /** Same kind, place and size; literals compare by content. */
+  friend constexpr bool operator==(const source& a, const source& b) noexcept {
+    if (a.kind_ != b.kind_ || a.address_ != b.address_ || !(a.ics_ == b.ics_) || a.size_ != b.size_) return false;
+    const auto x = a.literal_bytes(), y = b.literal_bytes();
+    return std::equal(x.begin(), x.end(), y.begin(), y.end());
+  }
 
+  /** One byte of RAM at 0x0000. */
   constexpr source() noexcept = default;
 
  private:
@@ -206,7 +244,8 @@ class source {
   std::uint32_t address_ = 0;
   ics_number ics_{};
   std::uint8_t size_ = 1;
-  byte_buffer<max_literal_size> literal_{};
+  std::array<std::uint8_t, 2> inline_{};    // literal_u8 / literal_u16
+  const std::uint8_t* external_ = nullptr;  // literal(span): referenced bytes
 };
 
 }  // namespace rcb4

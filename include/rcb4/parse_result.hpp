@@ -23,11 +23,11 @@ enum class parse_status : std::uint8_t {
 template <class T>
 struct parse_result {
   parse_status status = parse_status::need_more;  ///< complete, need_more or error
-  T value{};                  ///< the parsed value, when complete
-  std::size_t consumed = 0;   ///< bytes of the input that make up the frame (or the bad frame)
-  std::size_t needed = 0;     ///< with need_more: bytes still missing, at least 1
-  errc error{};               ///< with error: what was wrong
-  std::uint8_t command = 0;   ///< CMD byte of the frame, when at least 2 bytes were seen
+  T value{};                                      ///< the parsed value, when complete
+  std::size_t consumed = 0;                       ///< bytes of the input that make up the frame (or the bad frame)
+  std::size_t needed = 0;                         ///< with need_more: bytes still missing, at least 1
+  errc error{};                                   ///< with error: what was wrong
+  std::uint8_t command = 0;                       ///< CMD byte of the frame, when at least 2 bytes were seen
 
   /** True when a whole valid frame was parsed. */
   constexpr bool ok() const noexcept { return status == parse_status::complete; }

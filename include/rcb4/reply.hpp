@@ -12,6 +12,9 @@
 #include <rcb4/commands/common.hpp>
 #include <rcb4/parse_result.hpp>
 
+#include <algorithm>
+#include <span>
+
 namespace rcb4 {
 
 /** What kind of reply frame. */
@@ -24,11 +27,14 @@ class reply {
   static constexpr reply ack(std::uint8_t cmd) noexcept { return reply(reply_kind::ack, cmd); }
   /** NACK to command @p cmd. */
   static constexpr reply nack(std::uint8_t cmd) noexcept { return reply(reply_kind::nack, cmd); }
-  /** Data reply to @p cmd carrying @p bytes (1–252). */
+  /**
+   * Data reply to @p cmd carrying @p bytes (1–252). The bytes are referenced, not copied: a
+   * parsed reply points into the buffer it was parsed from (zero-copy, like std::span).
+   */
   static constexpr result<reply> data(std::uint8_t cmd, std::span<const std::uint8_t> bytes) noexcept {
     if (bytes.empty() || bytes.size() > max_reply_data) return errc::frame_too_long;
     reply r(reply_kind::data, cmd);
-    r.data_ = byte_buffer<max_reply_data>(bytes);
+    r.data_ = bytes;
     return r;
   }
   /** An ACK to ping. */
@@ -39,7 +45,7 @@ class reply {
   /** The CMD byte echoed. */
   constexpr std::uint8_t command() const noexcept { return cmd_; }
   /** The data bytes (empty for ACK/NACK). */
-  constexpr std::span<const std::uint8_t> bytes() const noexcept { return data_.bytes(); }
+  constexpr std::span<const std::uint8_t> bytes() const noexcept { return data_; }
   /** True for ACK. */
   constexpr bool is_ack() const noexcept { return kind_ == reply_kind::ack; }
   /** True for NACK. */
@@ -52,13 +58,17 @@ class reply {
   constexpr std::uint16_t u16(std::size_t offset = 0) const noexcept {
     return static_cast<std::uint16_t>(data_[offset] | (data_[offset + 1] << 8));
   }
-  friend constexpr bool operator==(const reply&, const reply&) noexcept = default;
+  /** Same kind and command; data compares by content. */
+  friend constexpr bool operator==(const reply& a, const reply& b) noexcept {
+    return a.kind_ == b.kind_ && a.cmd_ == b.cmd_ &&
+           std::equal(a.data_.begin(), a.data_.end(), b.data_.begin(), b.data_.end());
+  }
 
  private:
   constexpr reply(reply_kind k, std::uint8_t cmd) noexcept : kind_(k), cmd_(cmd) {}
   reply_kind kind_ = reply_kind::ack;
   std::uint8_t cmd_ = 0xFE;
-  byte_buffer<max_reply_data> data_{};
+  std::span<const std::uint8_t> data_{};
 };
 
 /** Board side: writes @p r into @p out; returns the length or errc::buffer_too_small. */
@@ -68,8 +78,10 @@ constexpr result<std::size_t> serialize(const reply& r, std::span<std::uint8_t> 
   detail::writer w(out);
   w.u8(static_cast<std::uint8_t>(n));
   w.u8(r.command());
-  if (r.kind() == reply_kind::data) w.bytes(r.bytes());
-  else w.u8(r.kind() == reply_kind::ack ? ack_code : nack_code);
+  if (r.kind() == reply_kind::data)
+    w.bytes(r.bytes());
+  else
+    w.u8(r.kind() == reply_kind::ack ? ack_code : nack_code);
   out[n - 1] = checksum(out.first(n - 1));
   return n;
 }
@@ -94,8 +106,10 @@ constexpr parse_result<reply> finish_reply(std::span<const std::uint8_t> frame, 
     return r;
   }
   if (status_frame) {
-    if (frame[2] == nack_code) r.value = reply::nack(frame[1]);
-    else if (frame[2] == ack_code && ack_allowed) r.value = reply::ack(frame[1]);
+    if (frame[2] == nack_code)
+      r.value = reply::nack(frame[1]);
+    else if (frame[2] == ack_code && ack_allowed)
+      r.value = reply::ack(frame[1]);
     else {
       r.error = frame[2] == ack_code ? errc::unexpected_ack : errc::bad_ack_code;
       return r;

@@ -27,6 +27,9 @@ class [[nodiscard]] result {
   using value_type = T;
   /** A successful result holding @p v. */
   constexpr result(T v) noexcept : value_(std::move(v)) {}  // NOLINT(google-explicit-constructor)
+  /** A successful result whose value is built in place from @p args (no copy of a large T). */
+  template <class... Args>
+  constexpr explicit result(std::in_place_t, Args&&... args) noexcept : value_(std::forward<Args>(args)...) {}
   /** A failed result; @p e must not be errc{}. */
   constexpr result(errc e) noexcept : error_(e) {  // NOLINT(google-explicit-constructor)
     if (e == errc{}) detail::bad_result_access();
@@ -86,7 +89,7 @@ class [[nodiscard]] result<void> {
 }  // namespace rcb4
 
 /// Propagates the error of a result-returning expression, else binds its value to @p var.
-#define RCB4_TRY(var, expr)                               \
-  auto var##_result_ = (expr);                            \
+#define RCB4_TRY(var, expr)                                     \
+  auto var##_result_ = (expr);                                  \
   if (!var##_result_.has_value()) return var##_result_.error(); \
   auto var = std::move(var##_result_).value()

@@ -12,8 +12,8 @@
 
 #include <array>
 #include <bit>
-#include <initializer_list>
 #include <cstdint>
+#include <initializer_list>
 #include <span>
 
 namespace rcb4 {
@@ -69,9 +69,7 @@ class servo_mask {
    public:
     constexpr iterator() noexcept = default;
     constexpr explicit iterator(std::uint64_t rest) noexcept : rest_(rest) {}
-    constexpr ics_number operator*() const noexcept {
-      return ics_number::make(std::countr_zero(rest_)).value();
-    }
+    constexpr ics_number operator*() const noexcept { return ics_number::make(std::countr_zero(rest_)).value(); }
     constexpr iterator& operator++() noexcept {
       rest_ &= rest_ - 1;
       return *this;
@@ -136,28 +134,33 @@ class servo_set {
 
   /** Sets the value of @p n, adding it if absent (keeps ascending order). */
   constexpr void insert(ics_number n, T value) noexcept {
+    if ((mask_.bits() >> n.value()) == 0) {  // above every member: append (the common case)
+      mask_.insert(n);
+      values_[count_++] = value;
+      return;
+    }
     const std::size_t i = mask_.rank(n);
     if (!mask_.contains(n)) {
-      for (std::size_t j = mask_.size(); j > i; --j) values_[j] = values_[j - 1];
+      for (std::size_t j = count_; j > i; --j) values_[j] = values_[j - 1];
       mask_.insert(n);
+      ++count_;
     }
     values_[i] = value;
   }
   /** Removes @p n if present. */
   constexpr void erase(ics_number n) noexcept {
     if (!mask_.contains(n)) return;
-    const std::size_t i = mask_.rank(n), count = mask_.size();
-    for (std::size_t j = i; j + 1 < count; ++j) values_[j] = values_[j + 1];
+    const std::size_t i = mask_.rank(n);
+    for (std::size_t j = i; j + 1 < count_; ++j) values_[j] = values_[j + 1];
     mask_.erase(n);
+    --count_;
   }
   /** True when @p n has a value. */
   constexpr bool contains(ics_number n) const noexcept { return mask_.contains(n); }
   /** The value of @p n, or nullptr when absent. */
-  constexpr const T* find(ics_number n) const noexcept {
-    return mask_.contains(n) ? &values_[mask_.rank(n)] : nullptr;
-  }
-  /** Number of servos (popcount of the mask). */
-  constexpr std::size_t size() const noexcept { return mask_.size(); }
+  constexpr const T* find(ics_number n) const noexcept { return mask_.contains(n) ? &values_[mask_.rank(n)] : nullptr; }
+  /** Number of servos (kept equal to the popcount of the mask). */
+  constexpr std::size_t size() const noexcept { return count_; }
   /** True when empty. */
   constexpr bool empty() const noexcept { return mask_.empty(); }
   /** The selected slots. */
@@ -195,13 +198,14 @@ class servo_set {
   /** Same servos with the same values. */
   friend constexpr bool operator==(const servo_set& a, const servo_set& b) noexcept {
     if (a.mask_ != b.mask_) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
+    for (std::size_t i = 0; i < a.count_; ++i)
       if (!(a.values_[i] == b.values_[i])) return false;
     return true;
   }
 
  private:
   servo_mask mask_{};
+  std::uint8_t count_ = 0;
   std::array<T, ics_slots> values_{};
 };
 

@@ -17,32 +17,40 @@
 namespace rcb4 {
 
 namespace detail {
-// Declared, never defined, never constexpr: a consteval constructor that calls one of these
-// cannot be evaluated, so the build fails with the function's name in the diagnostic.
-void ics_number_literal_out_of_range();
-void ram_address_literal_out_of_range();
-void rom_address_literal_out_of_range();
-void transfer_size_literal_out_of_range();
-void frames_literal_out_of_range();
-void servo_param_literal_out_of_range();
-void servo_position_literal_out_of_range();
-void shift_count_literal_out_of_range();
-
-struct ics_number_tag;
-struct ram_address_tag;
-struct rom_address_tag;
-struct transfer_size_tag;
-struct frames_tag;
-struct servo_param_tag;
-struct shift_count_tag;
+// Each bounded type's tag. fail() is declared, never defined, never constexpr: a consteval
+// constructor that calls it cannot be evaluated, so the build fails and the diagnostic names
+// the tag ("ics_number_literal_out_of_range::fail").
+struct ics_number_literal_out_of_range {
+  static void fail();
+};
+struct ram_address_literal_out_of_range {
+  static void fail();
+};
+struct rom_address_literal_out_of_range {
+  static void fail();
+};
+struct transfer_size_literal_out_of_range {
+  static void fail();
+};
+struct frames_literal_out_of_range {
+  static void fail();
+};
+struct servo_param_literal_out_of_range {
+  static void fail();
+};
+struct servo_position_literal_out_of_range {
+  static void fail();
+};
+struct shift_count_literal_out_of_range {
+  static void fail();
+};
 
 /**
- * An integer restricted to [Min, Max], stored as Rep. Tag makes each use a distinct type; Fail is
- * the compile-time diagnostic hook and Err the run-time error.
+ * An integer restricted to [Min, Max], stored as Rep. Tag makes each use a distinct type and
+ * names the compile-time failure; Err is the run-time error.
  */
-template <class Tag, class Rep, long long Min, long long Max, errc Err, void (*Fail)()>
+template <class Tag, class Rep, long long Min, long long Max, errc Err>
 class bounded {
-
  public:
   using rep = Rep;
   static constexpr Rep min = static_cast<Rep>(Min);  ///< smallest valid value
@@ -52,7 +60,7 @@ class bounded {
   constexpr bounded() noexcept = default;
   /** From an integer constant; an out-of-range constant does not compile. */
   consteval bounded(long long v) : v_(static_cast<Rep>(v)) {  // NOLINT(google-explicit-constructor)
-    if (v < Min || v > Max) Fail();
+    if (v < Min || v > Max) Tag::fail();
   }
   /** From a run-time integer: the value, or Err when outside [Min, Max]. */
   template <std::integral I>
@@ -73,41 +81,40 @@ class bounded {
 }  // namespace detail
 
 /** ICS number (servo slot) 0–35; slot 35 is the KRI-3/KRR receiver (protocol.md §5). */
-using ics_number = detail::bounded<detail::ics_number_tag, std::uint8_t, 0, 35, errc::ics_out_of_range,
-                                    &detail::ics_number_literal_out_of_range>;
+using ics_number =
+    detail::bounded<detail::ics_number_literal_out_of_range, std::uint8_t, 0, 35, errc::ics_out_of_range>;
 
 /** A RAM address 0x0000–0x048F (protocol.md §6). */
-using ram_address = detail::bounded<detail::ram_address_tag, std::uint16_t, 0x0000, 0x048F, errc::ram_address_out_of_range,
-                      &detail::ram_address_literal_out_of_range>;
+using ram_address = detail::bounded<detail::ram_address_literal_out_of_range, std::uint16_t, 0x0000, 0x048F,
+                                    errc::ram_address_out_of_range>;
 
 /** Bytes of RAM: addresses 0x0000–0x048F. */
 inline constexpr std::uint32_t ram_size = 0x0490;
 
 /** An EEPROM (ROM) address 0x000000–0x03FFFF, 256 KiB (protocol.md §8). */
-using rom_address = detail::bounded<detail::rom_address_tag, std::uint32_t, 0x000000, 0x03FFFF,
-                      errc::rom_address_out_of_range, &detail::rom_address_literal_out_of_range>;
+using rom_address = detail::bounded<detail::rom_address_literal_out_of_range, std::uint32_t, 0x000000, 0x03FFFF,
+                                    errc::rom_address_out_of_range>;
 
 /** Bytes of ROM: addresses 0x000000–0x03FFFF. */
 inline constexpr std::uint32_t rom_size = 0x040000;
 
 /** Size of a MOV / logic transfer: 1–128 bytes (DOC-CMD). */
-using transfer_size = detail::bounded<detail::transfer_size_tag, std::uint8_t, 1, 128, errc::transfer_size_out_of_range,
-                      &detail::transfer_size_literal_out_of_range>;
+using transfer_size =
+    detail::bounded<detail::transfer_size_literal_out_of_range, std::uint8_t, 1, 128, errc::transfer_size_out_of_range>;
 
 /**
  * The SPEED byte of SINGLE/CONST/SERIES: the number of interpolation frames, 0–255; larger is
  * slower, 0 moves at once; one frame is the output period (10–25 ms) (protocol.md §5, DOC-FW
  * 補間動作). This is KONDO's meaning; the 2015 C library inverted it (256 − speed).
  */
-using frames = detail::bounded<detail::frames_tag, std::uint8_t, 0, 255, errc::frames_out_of_range,
-                                &detail::frames_literal_out_of_range>;
+using frames = detail::bounded<detail::frames_literal_out_of_range, std::uint8_t, 0, 255, errc::frames_out_of_range>;
 
 /**
  * An ICS servo parameter (speed = output limit, stretch = softness) sent by command 0x12:
  * 1–127 (protocol.md §4.9, §11.4).
  */
-using servo_param = detail::bounded<detail::servo_param_tag, std::uint8_t, 1, 127, errc::param_out_of_range,
-                      &detail::servo_param_literal_out_of_range>;
+using servo_param =
+    detail::bounded<detail::servo_param_literal_out_of_range, std::uint8_t, 1, 127, errc::param_out_of_range>;
 
 /**
  * A servo output position: 0–16383 (ICS 14-bit range; KRS centre 7500, travel ≈ 3500–11500),
@@ -123,14 +130,14 @@ class servo_position {
   /** True when @p v is an ordinary position or FREE/HOLD. */
   template <std::integral I>
   static constexpr bool valid(I v) noexcept {
-    return (std::cmp_greater_equal(v, 0) && std::cmp_less_equal(v, max_angle_value)) ||
-           std::cmp_equal(v, free_value) || std::cmp_equal(v, hold_value);
+    return (std::cmp_greater_equal(v, 0) && std::cmp_less_equal(v, max_angle_value)) || std::cmp_equal(v, free_value) ||
+           std::cmp_equal(v, hold_value);
   }
   /** The KRS centre, 7500. */
   constexpr servo_position() noexcept = default;
   /** From an integer constant; an invalid constant does not compile. */
   consteval servo_position(long long v) : v_(static_cast<std::uint16_t>(v)) {  // NOLINT
-    if (!valid(v)) detail::servo_position_literal_out_of_range();
+    if (!valid(v)) detail::servo_position_literal_out_of_range::fail();
   }
   /** From a run-time integer; errc::position_out_of_range unless valid. */
   template <std::integral I>
@@ -160,8 +167,8 @@ class servo_position {
  * A shift count: positive shifts left, negative shifts right, −127…127 (protocol.md §4.2).
  * How it is put on the wire is disputed (§11.5); see rcb4::shift_encoding.
  */
-using shift_count = detail::bounded<detail::shift_count_tag, std::int8_t, -127, 127, errc::shift_count_out_of_range,
-                      &detail::shift_count_literal_out_of_range>;
+using shift_count =
+    detail::bounded<detail::shift_count_literal_out_of_range, std::int8_t, -127, 127, errc::shift_count_out_of_range>;
 
 /** The two halves of the RCB-4's servo connectors (protocol.md §5). */
 enum class sio_side : std::uint8_t {
@@ -171,7 +178,7 @@ enum class sio_side : std::uint8_t {
 
 /** A servo as HeartToHeart4 names it: the servo's own ID and the connector side it is on. */
 struct servo_address {
-  std::uint8_t id = 0;             ///< the ID stored in the ICS servo, 0–17
+  std::uint8_t id = 0;               ///< the ID stored in the ICS servo, 0–17
   sio_side side = sio_side::sio1_4;  ///< connector side
   friend constexpr bool operator==(servo_address, servo_address) noexcept = default;
 };

@@ -46,12 +46,14 @@ constexpr servo_set<servo_position> ordered() {
 static_assert(ordered().size() == 4);
 static_assert(ordered().values()[0] == servo_position{7500} && ordered().values()[1] == servo_position{8100} &&
               ordered().values()[2] == servo_position{7000} && ordered().values()[3] == servo_position{9000});
-static_assert(ordered().mask().encode(update_flags::replace) == std::array<std::uint8_t, 5>{0x09, 0x00, 0x10, 0x00, 0x08});
+static_assert(ordered().mask().encode(update_flags::replace) ==
+              std::array<std::uint8_t, 5>{0x09, 0x00, 0x10, 0x00, 0x08});
 static_assert(ordered().mask().encode(update_flags::leave)[4] == 0x88);
 constexpr bool erase_keeps_order() {
   auto s = ordered();
   s.erase(3);
-  return s.size() == 3 && s.values()[1] == servo_position{7000} && !s.contains(3) && *s.find(35) == servo_position{9000};
+  return s.size() == 3 && s.values()[1] == servo_position{7000} && !s.contains(3) &&
+         *s.find(35) == servo_position{9000};
 }
 static_assert(erase_keeps_order());
 static_assert(servo_mask::from_bits(std::uint64_t{1} << 36).error() == errc::ics_out_of_range);
@@ -66,7 +68,7 @@ static_assert(config_round_trip());
 static_assert(config_word{.led = true}.encode() == 0x8000);
 static_assert(config_word{.ics_baud = baud_code::b1250000}.encode() == 0x4000);  // bits 13-14 = 10
 static_assert(config_word{.com_baud = baud_code::b1250000}.encode() == 0x0080);  // bits 6-7 = 10
-static_assert(config_word{.period = output_period::ms20}.encode() == 0x0020);     // bits 4-5 = 10
+static_assert(config_word{.period = output_period::ms20}.encode() == 0x0020);    // bits 4-5 = 10
 static_assert(config_word::decode(0x000B).rom_program && config_word::decode(0x000B).vector_jump);
 static_assert(bits_per_second(baud_code::b115200_alt) == 115200 && milliseconds(output_period::ms25) == 25);
 
@@ -79,7 +81,8 @@ static_assert(motion_address(hth4_2_2, 120).value() == rom_address{0x000B80 + 11
 static_assert(motion_address(hth4_2_2, 121).error() == errc::motion_out_of_range);
 static_assert(motion_address(hth4_1_3, 2).value() == rom_address{0x000BB8 + 4864});
 static_assert(krr::encode_buttons(0x0140) == std::array<std::uint8_t, 2>{0x01, 0x40});
-static_assert(krr::decode_buttons(0x01, 0x40) == (static_cast<unsigned>(krr_button::square) | static_cast<unsigned>(krr_button::circle)));
+static_assert(krr::decode_buttons(0x01, 0x40) ==
+              (static_cast<unsigned>(krr_button::square) | static_cast<unsigned>(krr_button::circle)));
 static_assert(hth4_ram::user_param(19).value() == ram_address{0x0488} && !hth4_ram::counter(11));
 
 // Checksum (§2.1): the 2015 report's example 0x04 + 0xFE + 0x06 = 0x108 → 0x08.

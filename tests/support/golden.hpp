@@ -15,10 +15,10 @@ using bytes = std::span<const std::uint8_t>;
 
 /** A request frame and the command value it must be. */
 struct request {
-  const char* name;    ///< what it is
-  const char* source;  ///< where the layout comes from
-  bytes frame;         ///< the wire bytes
-  command value;       ///< the same command built through the API
+  const char* name;         ///< what it is
+  const char* source;       ///< where the layout comes from
+  bytes frame;              ///< the wire bytes
+  command value;            ///< the same command built through the API
   codec_options options{};  ///< how to parse it (disputed encodings)
 };
 
@@ -79,14 +79,12 @@ inline constexpr request requests[] = {
     {"ping, short form", "§4.11", ping_short, ping{ping_form::short_}},
     {"version", "§4.10", version_req, version{}},
     {"return", "§4.4", return_req, ret{}},
-    {"read config word (RAM 0x0000, 2 bytes → COM)", "§4.1, §8.1", read_config,
-     move::read_ram(0x0000, 2).value()},
+    {"read config word (RAM 0x0000, 2 bytes → COM)", "§4.1, §8.1", read_config, move::read_ram(0x0000, 2).value()},
     {"write config 0x0080 (suspend-style write)", "§8.1 step 1", write_config_0080,
      move::write_ram(0x0000, detail::w0080).value()},
     {"write config 0x000B (resume-style write)", "§8.1 step 4", write_config_000b,
      move::write_ram(0x0000, detail::w000b).value()},
-    {"reset PC to 0x00044B (HTH4 2.2)", "§8.1 step 2", reset_pc_2_2,
-     move::write_ram(0x0002, detail::zeros10).value()},
+    {"reset PC to 0x00044B (HTH4 2.2)", "§8.1 step 2", reset_pc_2_2, move::write_ram(0x0002, detail::zeros10).value()},
     {"CALL motion 1 (HTH4 2.2, 0x000B80)", "§4.3, §8", call_motion1, call{0x000B80}},
     {"CALL motion 3 (HTH4 2.2, 0x001B80)", "§4.3, §8", call_motion3, call{0x001B80}},
     {"JUMP 0x000B80", "§4.3", jump_0b80, jump{0x000B80}},
@@ -112,12 +110,13 @@ inline constexpr request requests[] = {
     {"read 16 bytes of ROM 0x000B80", "§4.1 (TYPE 0x23)", read_rom_motion1, move::read_rom(0x000B80, 16).value()},
     {"copy RAM config to ROM 0x0005DC", "§4.1 (TYPE 0x30), §9", ram_to_rom_config,
      move::make(destination::rom(0x0005DC), source::ram(0x0000, 2).value()).value()},
-    {"write AA 55 to ROM 0x001000", "§4.1 (TYPE 0x32)", literal_to_rom, move::write_rom(0x001000, detail::aa55).value()},
+    {"write AA 55 to ROM 0x001000", "§4.1 (TYPE 0x32)", literal_to_rom,
+     move::write_rom(0x001000, detail::aa55).value()},
     {"AND RAM 0x0090 with 0x0F", "§4.2", and_literal,
      logic::make(logic_op::and_, destination::ram(0x0090), source::literal(detail::x0f).value()).value()},
     {"XOR RAM 0x0091 with 0xFF, flags only", "§4.2", xor_flags_only,
-     logic::make(logic_op::xor_, destination::ram(0x0091), source::literal(detail::xff).value(),
-                 store_mode::flags_only).value()},
+     logic::make(logic_op::xor_, destination::ram(0x0091), source::literal(detail::xff).value(), store_mode::flags_only)
+         .value()},
     {"NOT 2 bytes at RAM 0x0090", "§4.2", not_2, bit_not::make(destination::ram(0x0090), 2).value()},
     {"SHIFT RAM 0x0090 left 3 (2015 encoding)", "§4.2, §11.5, report App. C", shift_left3,
      shift::make(destination::ram(0x0090), 3, 1).value()},
@@ -167,13 +166,25 @@ inline constexpr reply_case replies[] = {
     {"NACK to ping", "§2.2 (ROKI)", nack_ping, {0xFE, false, 0}, reply::nack(0xFE)},
     {"ACK to a MOV write", "§2.2", ack_mov, {0x00, false, 0}, reply::ack(0x00)},
     {"NACK to CALL", "§2.2", nack_call, {0x0C, false, 0}, reply::nack(0x0C)},
-    {"config word 0x4C83 (data reply to a 2-byte read)", "§2.2", config_data, {0x00, true, 2},
+    {"config word 0x4C83 (data reply to a 2-byte read)",
+     "§2.2",
+     config_data,
+     {0x00, true, 2},
      reply::data(0x00, detail::config_bytes).value()},
-    {"NACK where 2 data bytes were expected", "§2.2 (failure is a 4-byte NACK)", nack_call,
-     {0x0C, true, 2}, reply::nack(0x0C)},
-    {"1-byte data reply 0x15 (shape of a NACK)", "§2.2", one_byte_0x15, {0x00, true, 1},
+    {"NACK where 2 data bytes were expected",
+     "§2.2 (failure is a 4-byte NACK)",
+     nack_call,
+     {0x0C, true, 2},
+     reply::nack(0x0C)},
+    {"1-byte data reply 0x15 (shape of a NACK)",
+     "§2.2",
+     one_byte_0x15,
+     {0x00, true, 1},
      reply::data(0x00, detail::byte_15).value()},
-    {"VERSION of an RCB-4mini", "§4.10, §11.18 (IORY)", version_mini, {0xFD, true, 32},
+    {"VERSION of an RCB-4mini",
+     "§4.10, §11.18 (IORY)",
+     version_mini,
+     {0xFD, true, 32},
      reply::data(0xFD, std::span(version_mini).subspan(2, 32)).value()},
 };
 

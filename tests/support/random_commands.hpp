@@ -4,6 +4,7 @@
 
 #include <rcb4/rcb4.hpp>
 
+#include <deque>
 #include <random>
 #include <vector>
 
@@ -33,17 +34,22 @@ class command_generator {
   source src(int max_size = 128) {
     const int size = uniform(1, max_size);
     switch (uniform(0, 3)) {
-      case 0: return source::ram(ram_address::make(uniform(0, 0x0490 - size)).value(),
-                                 transfer_size::make(size).value()).value();
-      case 1: return source::ics(ics(), static_cast<std::uint8_t>(uniform(0, 256 - size)),
-                                 transfer_size::make(size).value()).value();
+      case 0:
+        return source::ram(ram_address::make(uniform(0, 0x0490 - size)).value(), transfer_size::make(size).value())
+            .value();
+      case 1:
+        return source::ics(ics(), static_cast<std::uint8_t>(uniform(0, 256 - size)), transfer_size::make(size).value())
+            .value();
       case 2: {
-        std::vector<std::uint8_t> b(static_cast<std::size_t>(std::min(size, 121)));
+        // Literals are views: the generator keeps the bytes alive for its whole life.
+        auto& b = literals_.emplace_back(static_cast<std::size_t>(std::min(size, 121)));
         for (auto& x : b) x = static_cast<std::uint8_t>(uniform(0, 255));
+        if (b.size() == 1 && coin()) return source::literal_u8(b[0]);
         return source::literal(b).value();
       }
-      default: return source::rom(rom_address::make(uniform(0, 0x40000 - size)).value(),
-                                  transfer_size::make(size).value()).value();
+      default:
+        return source::rom(rom_address::make(uniform(0, 0x40000 - size)).value(), transfer_size::make(size).value())
+            .value();
     }
   }
   /** A destination that can hold @p size bytes, COM allowed if @p com. */
@@ -69,61 +75,85 @@ class command_generator {
 
  private:
   std::mt19937 rng_;
+  std::deque<std::vector<std::uint8_t>> literals_;
 };
 
-template <> inline ping command_generator::make<ping>() { return ping(coin() ? ping_form::ack : ping_form::short_); }
-template <> inline version command_generator::make<version>() { return {}; }
-template <> inline ret command_generator::make<ret>() { return {}; }
-template <> inline move command_generator::make<move>() {
+template <>
+inline ping command_generator::make<ping>() {
+  return ping(coin() ? ping_form::ack : ping_form::short_);
+}
+template <>
+inline version command_generator::make<version>() {
+  return {};
+}
+template <>
+inline ret command_generator::make<ret>() {
+  return {};
+}
+template <>
+inline move command_generator::make<move>() {
   auto s = src();
   return move::make(dst(s.size(), true), s).value();
 }
-template <> inline logic command_generator::make<logic>() {
+template <>
+inline logic command_generator::make<logic>() {
   auto s = src();
   return logic::make(static_cast<logic_op>(uniform(1, 3)), dst(s.size(), false), s, mode()).value();
 }
-template <> inline arith command_generator::make<arith>() {
+template <>
+inline arith command_generator::make<arith>() {
   auto s = src(2);
   return arith::make(static_cast<arith_op>(uniform(6, 10)), dst(s.size(), false), s, mode()).value();
 }
-template <> inline bit_not command_generator::make<bit_not>() {
+template <>
+inline bit_not command_generator::make<bit_not>() {
   auto size = transfer_size::make(uniform(1, 128)).value();
   return bit_not::make(dst(size.value(), false), size, mode()).value();
 }
-template <> inline shift command_generator::make<shift>() {
+template <>
+inline shift command_generator::make<shift>() {
   auto size = transfer_size::make(uniform(1, 128)).value();
   return shift::make(dst(size.value(), false), shift_count::make(uniform(-127, 127)).value(), size,
                      coin() ? shift_encoding::measured_2015 : shift_encoding::kondo_manual, mode())
       .value();
 }
-template <> inline jump command_generator::make<jump>() {
+template <>
+inline jump command_generator::make<jump>() {
   condition c;
   if (coin()) c.zero = coin();
   if (coin()) c.carry = coin();
   return jump{rom_address::make(uniform(0, 0x3FFFF)).value(), c};
 }
-template <> inline call command_generator::make<call>() {
+template <>
+inline call command_generator::make<call>() {
   auto j = make<jump>();
   return call{j.target(), j.cond()};
 }
-template <> inline ics_exchange command_generator::make<ics_exchange>() {
+template <>
+inline ics_exchange command_generator::make<ics_exchange>() {
   const int len = uniform(1, 64);
   return ics_exchange::make(ics(), static_cast<std::uint8_t>(len), ram_address::make(uniform(0, 0x0490 - len)).value(),
                             ram_address::make(uniform(0, 0x048F)).value())
       .value();
 }
-template <> inline single_servo command_generator::make<single_servo>() {
+template <>
+inline single_servo command_generator::make<single_servo>() {
   return single_servo{ics(), position(), speed(), flags()};
 }
-template <> inline const_servo command_generator::make<const_servo>() {
+template <>
+inline const_servo command_generator::make<const_servo>() {
   return const_servo::make(set_of<servo_position>([this] { return position(); }), speed(), flags()).value();
 }
-template <> inline series_servo command_generator::make<series_servo>() {
-  return series_servo::make(series_opt_in, set_of<timed_position>([this] { return timed_position{position(), speed()}; }),
+template <>
+inline series_servo command_generator::make<series_servo>() {
+  return series_servo::make(series_opt_in, set_of<timed_position>([this] {
+                              return timed_position{position(), speed()};
+                            }),
                             flags())
       .value();
 }
-template <> inline servo_params command_generator::make<servo_params>() {
+template <>
+inline servo_params command_generator::make<servo_params>() {
   return servo_params::make(coin() ? param_kind::speed : param_kind::stretch,
                             set_of<servo_param>([this] { return servo_param::make(uniform(1, 127)).value(); }))
       .value();

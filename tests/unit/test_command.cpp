@@ -52,7 +52,7 @@ TEST_CASE("golden request frames parse identically when fed in pieces", "[comman
       auto partial = parse_command(g.frame.first(have), g.options);
       REQUIRE(partial.status == parse_status::need_more);
       REQUIRE(partial.needed >= 1);
-      REQUIRE(have + partial.needed <= g.frame.size());  // never asks for more than the frame
+      REQUIRE(have + partial.needed <= g.frame.size());                 // never asks for more than the frame
       if (have >= 1) REQUIRE(have + partial.needed == g.frame.size());  // length known from byte 0
     }
     // Trailing bytes of the next frame are not consumed.
@@ -92,7 +92,9 @@ TEST_CASE("board-side parse rejects every malformed command with the reason", "[
       {"MOV with the S bit", {0x0A, 0x00, 0xA0, 0, 0, 0, 0x00, 0x00, 0x02}, errc::flags_only_not_allowed},
       {"MOV TYPE bit 6", {0x0A, 0x00, 0x60, 0, 0, 0, 0x00, 0x00, 0x02}, errc::bad_type_byte},
       {"MOV TYPE bit 2", {0x0A, 0x00, 0x24, 0, 0, 0, 0x00, 0x00, 0x02}, errc::bad_type_byte},
-      {"MOV RAM destination, third byte set", {0x09, 0x00, 0x02, 0x00, 0x00, 0x01, 0x80, 0x00}, errc::reserved_bits_set},
+      {"MOV RAM destination, third byte set",
+       {0x09, 0x00, 0x02, 0x00, 0x00, 0x01, 0x80, 0x00},
+       errc::reserved_bits_set},
       {"MOV COM destination not zero", {0x0A, 0x00, 0x20, 0x01, 0, 0, 0x00, 0x00, 0x02}, errc::reserved_bits_set},
       {"MOV read past the end of RAM", {0x0A, 0x00, 0x20, 0, 0, 0, 0x80, 0x04, 0x20}, errc::ram_address_out_of_range},
       {"MOV RAM address 0x0490", {0x0A, 0x00, 0x20, 0, 0, 0, 0x90, 0x04, 0x02}, errc::ram_address_out_of_range},
@@ -104,7 +106,9 @@ TEST_CASE("board-side parse rejects every malformed command with the reason", "[
       {"MOV ROM source in 10 bytes", {0x0A, 0x00, 0x23, 0, 0, 0, 0x00, 0x00, 0x02}, errc::bad_frame_size},
       {"MOV ROM 0x040000", {0x0B, 0x00, 0x23, 0, 0, 0, 0x00, 0x00, 0x04, 0x10}, errc::rom_address_out_of_range},
       {"MOV literal past RAM end", {0x09, 0x00, 0x02, 0x8F, 0x04, 0x00, 0x01, 0x02}, errc::ram_address_out_of_range},
-      {"MOV ROM destination past the end", {0x09, 0x00, 0x32, 0xFF, 0xFF, 0x03, 0x01, 0x02}, errc::rom_address_out_of_range},
+      {"MOV ROM destination past the end",
+       {0x09, 0x00, 0x32, 0xFF, 0xFF, 0x03, 0x01, 0x02},
+       errc::rom_address_out_of_range},
       {"MOV with no source", {0x07, 0x00, 0x02, 0x00, 0x00, 0x00}, errc::bad_frame_size},
       {"AND to COM", {0x08, 0x01, 0x22, 0, 0, 0, 0x0F}, errc::destination_not_allowed},
       {"XOR to COM", {0x08, 0x03, 0x22, 0, 0, 0, 0x0F}, errc::destination_not_allowed},
@@ -141,7 +145,9 @@ TEST_CASE("board-side parse rejects every malformed command with the reason", "[
       {"PARAM with the update-flag bit", {0x0A, 0x12, 0x01, 0, 0, 0, 0x80, 0x02, 0x64}, errc::reserved_bits_set},
       {"ICS 0x0E length 0", {0x09, 0x0E, 0x02, 0x00, 0x00, 0x04, 0x10, 0x04}, errc::ics_length_out_of_range},
       {"ICS 0x0E length 65", {0x09, 0x0E, 0x02, 0x41, 0x00, 0x04, 0x10, 0x04}, errc::ics_length_out_of_range},
-      {"ICS 0x0E answer address 0x0490", {0x09, 0x0E, 0x02, 0x03, 0x00, 0x04, 0x90, 0x04}, errc::ram_address_out_of_range},
+      {"ICS 0x0E answer address 0x0490",
+       {0x09, 0x0E, 0x02, 0x03, 0x00, 0x04, 0x90, 0x04},
+       errc::ram_address_out_of_range},
       {"ICS 0x0E ICS 36", {0x09, 0x0E, 0x24, 0x03, 0x00, 0x04, 0x10, 0x04}, errc::ics_out_of_range},
   };
   for (const auto& c : cases) {
@@ -208,8 +214,7 @@ TEST_CASE("host-side factories refuse what the board would refuse", "[command][e
   CHECK(move::read_rom(0x3FFF0, 17).error() == errc::rom_address_out_of_range);
   CHECK(move::read_ics(0, 250, 7).error() == errc::ics_offset_out_of_range);
   CHECK(move::write_ics(0, 255, std::span(big).first(2)).error() == errc::ics_offset_out_of_range);
-  CHECK(move::make(destination::ram(0x048F), source::ram(0x0090, 2).value()).error() ==
-        errc::ram_address_out_of_range);
+  CHECK(move::make(destination::ram(0x048F), source::ram(0x0090, 2).value()).error() == errc::ram_address_out_of_range);
   CHECK(logic::make(logic_op::or_, destination::com(), source::literal_u8(1)).error() == errc::destination_not_allowed);
   CHECK(arith::make(arith_op::mul, destination::ram(0x0090), source::ram(0x0092, 3).value()).error() ==
         errc::operand_size_out_of_range);

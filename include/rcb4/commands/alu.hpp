@@ -60,8 +60,8 @@ class logic {
  private:
   constexpr logic(logic_op op, detail::transfer t) noexcept : op_(op), t_(t) {}
   logic_op op_ = logic_op::and_;
-  detail::transfer t_{store_mode::store, destination::ram(ram_address{0x90}),
-                      source::ram(ram_address{0x90}, transfer_size{1}).value()};
+  detail::transfer t_{store_mode::store, destination::ram(detail::default_ram),
+                      source::ram(detail::default_ram, detail::one_byte).value()};
 };
 
 /**
@@ -76,8 +76,7 @@ class arith {
   enum class com_output : std::uint8_t { forbid, allow };
 
   /** @p op of @p src into @p dst; operand 1–2 bytes; COM only with com_output::allow. */
-  static constexpr result<arith> make(arith_op op, destination dst, source src,
-                                      store_mode mode = store_mode::store,
+  static constexpr result<arith> make(arith_op op, destination dst, source src, store_mode mode = store_mode::store,
                                       com_output com = com_output::forbid) noexcept {
     if (dst.kind() == dst_kind::com && com != com_output::allow) return errc::destination_not_allowed;
     if (src.size() < 1 || src.size() > 2) return errc::operand_size_out_of_range;
@@ -116,8 +115,8 @@ class arith {
  private:
   constexpr arith(arith_op op, detail::transfer t) noexcept : op_(op), t_(t) {}
   arith_op op_ = arith_op::add;
-  detail::transfer t_{store_mode::store, destination::ram(ram_address{0x90}),
-                      source::ram(ram_address{0x90}, transfer_size{1}).value()};
+  detail::transfer t_{store_mode::store, destination::ram(detail::default_ram),
+                      source::ram(detail::default_ram, detail::one_byte).value()};
 };
 
 namespace detail {
@@ -126,7 +125,7 @@ struct unary_layout {
   store_mode mode = store_mode::store;
   destination dst{};
   std::uint8_t arg = 0;
-  transfer_size size{1};
+  transfer_size size = detail::one_byte;
 
   static constexpr std::size_t wire_size = 10;
   constexpr void write_body(writer& w) const noexcept {
@@ -196,7 +195,7 @@ class bit_not {
 
  private:
   constexpr explicit bit_not(detail::unary_layout l) noexcept : l_(l) {}
-  detail::unary_layout l_{store_mode::store, destination::ram(ram_address{0x90}), 0, transfer_size{1}};
+  detail::unary_layout l_{store_mode::store, destination::ram(detail::default_ram), 0, detail::one_byte};
 };
 
 /**
@@ -260,10 +259,9 @@ class shift {
   constexpr shift() noexcept = default;
 
  private:
-  constexpr shift(detail::unary_layout l, shift_count c, shift_encoding e) noexcept
-      : l_(l), count_(c), enc_(e) {}
-  detail::unary_layout l_{store_mode::store, destination::ram(ram_address{0x90}), 0, transfer_size{1}};
-  shift_count count_{0};
+  constexpr shift(detail::unary_layout l, shift_count c, shift_encoding e) noexcept : l_(l), count_(c), enc_(e) {}
+  detail::unary_layout l_{store_mode::store, destination::ram(detail::default_ram), 0, detail::one_byte};
+  shift_count count_{};
   shift_encoding enc_ = shift_encoding::measured_2015;
 };
 

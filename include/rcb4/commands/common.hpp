@@ -54,12 +54,11 @@ enum class update_flags : std::uint8_t {
  * bytes between CMD and SUM, what reply it expects, and how to read itself from a checked frame.
  */
 template <class T>
-concept Command = std::regular<T> && requires(const T& c, detail::writer& w,
-                                             std::span<const std::uint8_t> frame,
-                                             const codec_options& opt) {
+concept Command = std::regular<T> &&
+    requires(const T& c, detail::writer& w, std::span<const std::uint8_t> frame, const codec_options& opt) {
   { c.code() } -> std::same_as<std::uint8_t>;
   { c.wire_size() } -> std::same_as<std::size_t>;
-  { c.write_body(w) };
+  {c.write_body(w)};
   { c.expected_reply() } -> std::same_as<reply_shape>;
   { T::parse(frame, opt) } -> std::same_as<result<T>>;
 };

@@ -41,9 +41,7 @@ struct condition {
     return c;
   }
   /** True when flags @p z and @p c satisfy the condition. */
-  constexpr bool holds(bool z, bool c) const noexcept {
-    return (!zero || *zero == z) && (!carry || *carry == c);
-  }
+  constexpr bool holds(bool z, bool c) const noexcept { return (!zero || *zero == z) && (!carry || *carry == c); }
   friend constexpr bool operator==(const condition&, const condition&) noexcept = default;
 };
 

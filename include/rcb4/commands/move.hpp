@@ -20,13 +20,13 @@ class move {
   /** Any source to any destination; the destination range must hold the source's size. */
   static constexpr result<move> make(destination dst, source src) noexcept {
     if (auto ok = dst.check_range(src.size()); !ok) return ok.error();
-    return move{detail::transfer{store_mode::store, dst, src}};
+    return result<move>(std::in_place, detail::transfer{store_mode::store, dst, src});
   }
   /** Reads @p size bytes of RAM at @p a (RAM → COM, TYPE 0x20). */
   static constexpr result<move> read_ram(ram_address a, transfer_size size) noexcept {
-    auto s = source::ram(a, size);
-    if (!s) return s.error();
-    return make(destination::com(), *s);
+    if (a.value() + std::size_t{size.value()} > ram_size) return errc::ram_address_out_of_range;
+    return result<move>(std::in_place,
+                        detail::transfer{store_mode::store, destination::com(), source::ram(a, size).value()});
   }
   /** Writes @p bytes (1–121) to RAM at @p a (literal → RAM, TYPE 0x02). */
   static constexpr result<move> write_ram(ram_address a, std::span<const std::uint8_t> bytes) noexcept {
@@ -90,8 +90,9 @@ class move {
   constexpr move() noexcept = default;
 
  private:
+  friend class result<move>;
   constexpr explicit move(detail::transfer t) noexcept : t_(t) {}
-  detail::transfer t_{store_mode::store, destination::com(), source::ram(ram_address{0}, transfer_size{1}).value()};
+  detail::transfer t_{store_mode::store, destination::com(), source::ram(detail::zero_ram, detail::one_byte).value()};
 };
 
 }  // namespace rcb4

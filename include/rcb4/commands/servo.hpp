@@ -88,11 +88,7 @@ class const_servo {
   static constexpr result<const_servo> make(const servo_set<servo_position>& targets, frames speed,
                                             update_flags flags = update_flags::replace) noexcept {
     if (targets.empty()) return errc::empty_servo_set;
-    const_servo c;
-    c.targets_ = targets;
-    c.speed_ = speed;
-    c.flags_ = flags;
-    return c;
+    return result<const_servo>(std::in_place, targets, speed, flags);
   }
   /** Servo targets. */
   constexpr const servo_set<servo_position>& targets() const noexcept { return targets_; }
@@ -129,10 +125,13 @@ class const_servo {
   }
   friend constexpr bool operator==(const const_servo&, const const_servo&) noexcept = default;
   /** ICS 0 to the centre at once. */
-  constexpr const_servo() noexcept = default;
+  constexpr const_servo() noexcept { targets_.insert(ics_number{}, servo_position{}); }
 
  private:
-  servo_set<servo_position> targets_{{ics_number{0}, servo_position{}}};
+  friend class result<const_servo>;
+  constexpr const_servo(const servo_set<servo_position>& t, frames s, update_flags f) noexcept
+      : targets_(t), speed_(s), flags_(f) {}
+  servo_set<servo_position> targets_{};
   frames speed_{};
   update_flags flags_ = update_flags::replace;
 };
@@ -202,10 +201,10 @@ class series_servo {
   }
   friend constexpr bool operator==(const series_servo&, const series_servo&) noexcept = default;
   /** ICS 0 to the centre at once. */
-  constexpr series_servo() noexcept = default;
+  constexpr series_servo() noexcept { targets_.insert(ics_number{}, timed_position{}); }
 
  private:
-  servo_set<timed_position> targets_{{ics_number{0}, timed_position{}}};
+  servo_set<timed_position> targets_{};
   update_flags flags_ = update_flags::replace;
 };
 
@@ -264,11 +263,11 @@ class servo_params {
   }
   friend constexpr bool operator==(const servo_params&, const servo_params&) noexcept = default;
   /** Stretch of ICS 0 set to 1. */
-  constexpr servo_params() noexcept = default;
+  constexpr servo_params() noexcept { values_.insert(ics_number{}, servo_param{}); }
 
  private:
   param_kind kind_ = param_kind::stretch;
-  servo_set<servo_param> values_{{ics_number{0}, servo_param{1}}};
+  servo_set<servo_param> values_{};
 };
 
 }  // namespace rcb4

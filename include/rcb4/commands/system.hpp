@@ -9,14 +9,15 @@
 #pragma once
 
 #include <rcb4/commands/common.hpp>
+#include <rcb4/operand.hpp>
 #include <rcb4/values.hpp>
 
 namespace rcb4 {
 
 /** The two request forms of the ACK check; both get `04 FE 06 08`. */
 enum class ping_form : std::uint8_t {
-  ack = 0,    ///< 04 FE 06 08: KONDO's libraries, IORY, GMU
-  short_ = 1, ///< 03 FE 01: DOC-CMD's primary form, the 2015 library's "new ping"
+  ack = 0,     ///< 04 FE 06 08: KONDO's libraries, IORY, GMU
+  short_ = 1,  ///< 03 FE 01: DOC-CMD's primary form, the 2015 library's "new ping"
 };
 
 /** Ping: checks that a board answers. No effect on the board. */
@@ -133,8 +134,8 @@ class ics_exchange {
  private:
   ics_number ics_{};
   std::uint8_t tx_length_ = 1;
-  ram_address tx_{0x90};
-  ram_address rx_{0x90};
+  ram_address tx_ = detail::default_ram;
+  ram_address rx_ = detail::default_ram;
 };
 
 }  // namespace rcb4

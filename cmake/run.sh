@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# The project's entry points (the README's Quick start):
+#   cmake/run.sh demo   install what is missing, build, run the demo
+#   cmake/run.sh test   install what is missing, build and run every test configuration
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cmake/install-deps.sh
+
+# Builds preset $1 and runs its tests.
+build_and_test() {
+  echo "==> $1: configure, build, test"
+  cmake --preset "$1" >/dev/null
+  cmake --build --preset "$1"
+  ctest --preset "$1"
+}
+
+case "${1:-}" in
+  demo)
+    cmake --preset dev >/dev/null
+    cmake --build --preset dev --target rcb4_codec_tour
+    ./build/dev/examples/rcb4_codec_tour
+    ;;
+  test)
+    build_and_test dev            # GCC 12, warnings as errors: unit, static, compile-fail, fuzz replay, Cortex-M4
+    build_and_test asan-ubsan     # clang 16 with ASan + UBSan, and each libFuzzer harness for a short run
+    build_and_test no-exceptions  # the codec with -fno-exceptions -fno-rtti
+    echo "==> all test configurations passed"
+    ;;
+  *)
+    echo "usage: cmake/run.sh demo|test" >&2
+    exit 2
+    ;;
+esac
