@@ -1,0 +1,86 @@
+// rcb4 — the virtual board's default ROM: an HTH4 2.2-style layout with a main loop and demo motions.
+// SPDX-License-Identifier: BSL-1.0
+//
+// Layout (protocol.md §8, HTH4 2.2+):
+//   0x000000  boot: MOV ROM 0x0005DC → RAM 0x0000 (config word), then JUMP 0x00044B
+//   0x00044B  main loop: JUMP 0x00044B (the program idles here; motions are CALLed)
+//   0x0005DC  ConfigDataRom: the config word loaded at power-on
+//   0x000B80 + 2048·(n−1)  motion n: CONST poses, then RETURN
+#pragma once
+
+#include <rcb4/memory_map.hpp>
+#include <rcb4/rcb4.hpp>
+
+#include <cstdint>
+#include <initializer_list>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace rcb4::board {
+
+/** The servo slots the default robot has: ICS 0–21 (IDs 0–10 on both connector sides, like a KHR-3HV). */
+inline constexpr std::uint8_t default_servo_count = 22;
+
+/** Power-on config word of the default ROM: ICS on, ROM program on, vector jump on, 10 ms, COM 1.25 Mbaud. */
+inline constexpr std::uint16_t default_config = 0x008B;
+
+/** A demo motion: a name and its poses (each pose: frames, then ICS → position). */
+struct demo_pose {
+  std::uint8_t frames;
+  std::initializer_list<std::pair<std::uint8_t, std::uint16_t>> targets;
+};
+
+/** Writes @p frame at @p addr of @p rom; returns the address after it. */
+inline std::uint32_t put_frame(std::vector<std::uint8_t>& rom, std::uint32_t addr, const request_frame& frame) {
+  for (std::size_t i = 0; i < frame.size(); ++i) rom[addr + i] = frame[i];
+  return static_cast<std::uint32_t>(addr + frame.size());
+}
+
+/** Writes motion @p number of @p layout: one CONST per pose, then RETURN. */
+inline void put_motion(std::vector<std::uint8_t>& rom, const rom_layout& layout, unsigned number,
+                       std::initializer_list<demo_pose> poses) {
+  std::uint32_t at = motion_address(layout, number).value().value();
+  for (const auto& pose : poses) {
+    servo_set<servo_position> set;
+    for (auto [ics, pos] : pose.targets) set.insert(ics_number::make(ics).value(), servo_position::make(pos).value());
+    at = put_frame(rom, at, encode(const_servo::make(set, frames::make(pose.frames).value()).value()));
+  }
+  put_frame(rom, at, encode(ret{}));
+}
+
+/** Names of the demo motions, 1-based (index 0 is motion 1). */
+inline constexpr std::string_view demo_motion_names[] = {"home", "wave", "bow"};
+
+/**
+ * The default 256 KiB ROM image: boot, main loop, config word, and three demo motions:
+ * 1 "home" (every servo to 7500), 2 "wave" (right arm), 3 "bow" (hips and knees).
+ */
+inline std::vector<std::uint8_t> default_rom() {
+  std::vector<std::uint8_t> rom(rom_size, 0xFF);  // erased EEPROM reads 0xFF
+  const auto& l = hth4_2_2;
+  std::uint32_t at = 0;
+  at = put_frame(rom, at, encode(move::make(destination::ram(ram::config), source::rom(l.config, 2).value()).value()));
+  put_frame(rom, at, encode(jump{l.main_loop}));
+  put_frame(rom, l.main_loop.value(), encode(jump{l.main_loop}));
+  rom[l.config.value()] = static_cast<std::uint8_t>(default_config & 0xFF);
+  rom[l.config.value() + 1] = static_cast<std::uint8_t>(default_config >> 8);
+
+  put_motion(rom, l, 1,
+             {{30, {{0, 7500}, {1, 7500}, {2, 7500}, {3, 7500}, {4, 7500}, {5, 7500}, {6, 7500}, {7, 7500},
+                    {8, 7500}, {9, 7500}, {10, 7500}, {11, 7500}, {12, 7500}, {13, 7500}, {14, 7500},
+                    {15, 7500}, {16, 7500}, {17, 7500}, {18, 7500}, {19, 7500}, {20, 7500}, {21, 7500}}}});
+  put_motion(rom, l, 2,
+             {{20, {{3, 9500}, {5, 10500}}},
+              {10, {{5, 9000}}},
+              {10, {{5, 10500}}},
+              {10, {{5, 9000}}},
+              {20, {{3, 7500}, {5, 7500}}}});
+  put_motion(rom, l, 3,
+             {{25, {{12, 6500}, {13, 8500}, {16, 8500}, {17, 6500}}},
+              {15, {{12, 6500}, {13, 8500}}},
+              {25, {{12, 7500}, {13, 7500}, {16, 7500}, {17, 7500}}}});
+  return rom;
+}
+
+}  // namespace rcb4::board
