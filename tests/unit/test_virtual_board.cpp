@@ -32,8 +32,10 @@ TEST_CASE("board: power-on RAM is an HTH4 2.2 boot", "[board]") {
   for (unsigned k = 0; k < 4; ++k) CHECK(w.read_word(static_cast<std::uint16_t>(0x003C + 2 * k)) == 0x8000);
   for (unsigned k = 0; k < 36; ++k) {
     const auto entry = w.read_word(static_cast<std::uint16_t>(0x0044 + 2 * k));
-    if (k < 22 || k == 35) CHECK(entry == 0x0090 + 20 * k);
-    else CHECK(entry == 0xFFFF);
+    if (k < 22 || k == 35)
+      CHECK(entry == 0x0090 + 20 * k);
+    else
+      CHECK(entry == 0xFFFF);
   }
   CHECK(w.read_word(0x0090 + 4) == 7500);  // ICS 0 current position
   CHECK(w.read_word(0x008C) == 0x0357);    // vector table
@@ -85,8 +87,8 @@ TEST_CASE("board: logic, NOT and SHIFT with Z/C flags and the S bit", "[board][a
   CHECK(r.bytes()[0] == 0xFF);
   CHECK_FALSE(flags().zero_flag);
   // Flags only: the result comes back, memory is unchanged.
-  r = w.send(logic::make(logic_op::xor_, destination::ram(0x0401), source::literal_u8(0xFF), store_mode::flags_only)
-                 .value());
+  r = w.send(
+      logic::make(logic_op::xor_, destination::ram(0x0401), source::literal_u8(0xFF), store_mode::flags_only).value());
   CHECK(r.bytes()[0] == 0x00);
   CHECK(flags().zero_flag);
   CHECK(w.read_ram(0x0401, 1)[0] == 0xFF);
@@ -127,15 +129,16 @@ TEST_CASE("board: arithmetic, carry and borrow", "[board][alu]") {
   // (2-byte operands: a 1-byte data reply and a NACK have the same shape on the wire, §2.2)
   CHECK(w.send(arith::make(arith_op::div, destination::ram(0x0464), source::literal_u16(0)).value()).is_nack());
   // Compare without storing (S bit).
-  CHECK(w.send(arith::make(arith_op::sub, destination::ram(0x0464), source::literal_u8(2), store_mode::flags_only)
-                   .value())
-            .bytes()[0] == 0);
+  CHECK(
+      w.send(
+           arith::make(arith_op::sub, destination::ram(0x0464), source::literal_u8(2), store_mode::flags_only).value())
+          .bytes()[0] == 0);
   CHECK(zero());
   CHECK(w.read_ram(0x0464, 1)[0] == 2);
   // Arithmetic to COM: refused by default (2015 report), answered with the opt-in.
-  const auto to_com =
-      arith::make(arith_op::add, destination::com(), source::literal_u16(5), store_mode::store, arith::com_output::allow)
-          .value();
+  const auto to_com = arith::make(arith_op::add, destination::com(), source::literal_u16(5), store_mode::store,
+                                  arith::com_output::allow)
+                          .value();
   CHECK(w.send(to_com).is_nack());
   board_wire permissive(board::options{.allow_arith_to_com = true});
   CHECK(permissive.send(to_com).u16() == 5);
@@ -152,9 +155,10 @@ TEST_CASE("board: JUMP, CALL and RETURN with conditions and a 16-deep stack", "[
   CHECK(w.send(jump{0x001000}).is_ack());
   CHECK(pc() == 0x001000);
   // Z is 0 after this compare: "if Z=1" is not taken, "if Z=0" is.
-  REQUIRE(w.send(arith::make(arith_op::sub, destination::ram(0x0400), source::literal_u8(1), store_mode::flags_only)
-                     .value())
-              .kind() == reply_kind::data);
+  REQUIRE(
+      w.send(
+           arith::make(arith_op::sub, destination::ram(0x0400), source::literal_u8(1), store_mode::flags_only).value())
+          .kind() == reply_kind::data);
   CHECK(w.send(jump{0x002000, condition{true, {}}}).is_ack());
   CHECK(pc() == 0x001000);
   CHECK(w.send(jump{0x002000, condition{false, {}}}).is_ack());
@@ -179,7 +183,7 @@ TEST_CASE("board: SINGLE and CONST interpolate over frames; FREE and HOLD", "[bo
   const std::uint16_t ics2_pos = 0x0090 + 40 + 4, ics2_out = 0x0090 + 40 + 6;
   CHECK(w.send(single_servo{2, 8500, 10}).is_ack());
   CHECK(w.read_ram(0x0007, 1)[0] == 0x04);  // update flag of ICS 2 set
-  w.wait(50ms);                            // 5 of 10 frames at 10 ms
+  w.wait(50ms);                             // 5 of 10 frames at 10 ms
   CHECK(w.read_word(ics2_pos) == 8000);
   w.wait(50ms);
   CHECK(w.read_word(ics2_pos) == 8500);
@@ -204,7 +208,7 @@ TEST_CASE("board: SERIES reboots by default, as measured in 2015; executes when 
   const auto series = series_servo::make(series_opt_in, {{0, {8000, 0}}, {1, {6000, 0}}}).value();
   const auto frame = encode(series);
   CHECK(w.send_bytes(frame.bytes()).empty());  // silence
-  CHECK(w.read_ram(0x0400, 1)[0] == 0x00);      // RAM back to power-on
+  CHECK(w.read_ram(0x0400, 1)[0] == 0x00);     // RAM back to power-on
   CHECK(w.board().stats().reboots == 1);
   board_wire e(board::options{.series = board::series_behaviour::execute});
   CHECK(e.send(series).is_ack());
@@ -240,7 +244,7 @@ TEST_CASE("board: NACK and silence where the board gives them", "[board][errors]
   board_wire strict(board::options{.strict_timing = true});
   CHECK(strict.send_bytes(std::span(p).first(2)).empty());
   CHECK(strict.send_bytes(std::span(p).subspan(2), 200us).empty());
-  CHECK(strict.board().pending_bytes() == 2);  // the tail waits as the start of a new frame
+  CHECK(strict.board().pending_bytes() == 2);                              // the tail waits as the start of a new frame
   CHECK(strict.send_bytes(p, 1000us) == bytes({0x04, 0xFE, 0x06, 0x08}));  // next frame is fine
 }
 
@@ -279,7 +283,7 @@ TEST_CASE("board: KONDO's four-step motion play moves the servos, status per §8
   CHECK(status() == 2);
   int guard = 0;
   while (status() != 0 && guard++ < 100) w.wait(10ms);
-  CHECK(status() == 0);                           // back in the main loop
+  CHECK(status() == 0);                         // back in the main loop
   CHECK(w.read_word(0x0090 + 60 + 4) == 7500);  // arm down again
   CHECK(w.read_word(0x0090 + 100 + 4) == 7500);
   CHECK(config_word::decode(w.read_word(0)).rom_program);

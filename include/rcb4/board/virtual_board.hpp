@@ -15,8 +15,8 @@
 //  - Timing model: everything happens on output-period ticks (10/15/20/25 ms, config bits 4-5).
 //    Each tick moves every interpolating servo one step ((end − output) / steps remaining), clears
 //    the update flag (0x0007) of servos that finished, then runs the ROM program (if config bit 1
-//    is set) until it reaches a servo command whose flags are still set, a RETURN to idle, or a
-//    budget of 256 commands (the idle main loop is a JUMP to itself). The measured position (+4)
+//    is set) until it reaches a servo command whose flags are still set, a JUMP to itself (the
+//    idle main loop), or a budget of 256 commands. The measured position (+4)
 //    follows the output at once (model: ideal servos, no mixing). AD values get ±1 LSB of noise
 //    per tick; timers count down every 100 ms.
 //  - A write that changes the COM baud bits takes effect after its reply (line_baud()).
@@ -29,8 +29,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <optional>
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <span>
 #include <utility>
@@ -50,9 +50,9 @@ struct options {
   shift_encoding shift = shift_encoding::measured_2015;  ///< §11.5
   bool allow_arith_to_com = false;                       ///< §11.6
   series_behaviour series = series_behaviour::reboot;    ///< §11.2
-  bool strict_timing = false;   ///< drop a partial frame after a 150 µs gap (DOC-FW "COM")
-  std::uint32_t seed = 1;       ///< AD noise
-  std::uint8_t servo_count = default_servo_count;  ///< ICS 0..servo_count−1 are allocated servos
+  bool strict_timing = false;                            ///< drop a partial frame after a 150 µs gap (DOC-FW "COM")
+  std::uint32_t seed = 1;                                ///< AD noise
+  std::uint8_t servo_count = default_servo_count;        ///< ICS 0..servo_count−1 are allocated servos
 };
 
 /** Board time: microseconds since an epoch of the caller's choosing. */
@@ -68,13 +68,13 @@ inline constexpr std::array<std::uint8_t, version_field_size> default_identity =
 
 /** Counters of what the board saw. */
 struct statistics {
-  std::uint64_t frames = 0;    ///< complete frames received
-  std::uint64_t acks = 0;      ///< ACK replies sent
-  std::uint64_t nacks = 0;     ///< NACK replies sent
-  std::uint64_t data = 0;      ///< data replies sent
-  std::uint64_t dropped = 0;   ///< bytes discarded (bad size byte, timing gaps)
-  std::uint64_t reboots = 0;   ///< resets (SERIES with series_behaviour::reboot)
-  std::uint64_t rom_steps = 0; ///< commands executed from ROM
+  std::uint64_t frames = 0;     ///< complete frames received
+  std::uint64_t acks = 0;       ///< ACK replies sent
+  std::uint64_t nacks = 0;      ///< NACK replies sent
+  std::uint64_t data = 0;       ///< data replies sent
+  std::uint64_t dropped = 0;    ///< bytes discarded (bad size byte, timing gaps)
+  std::uint64_t reboots = 0;    ///< resets (SERIES with series_behaviour::reboot)
+  std::uint64_t rom_steps = 0;  ///< commands executed from ROM
 };
 
 /** An emulated RCB-4HV. Not thread-safe: one owner feeds it. */
@@ -83,7 +83,7 @@ class virtual_board {
   static constexpr std::size_t stack_depth = 16;  ///< CALL nesting (DOC-CMD/DOC-FW)
 
   /** A board with the default ROM image, powered on at board time 0. */
-  explicit virtual_board(options opt = {}) : opt_(opt), rom_(default_rom()), rng_(opt.seed) { power_on(); }
+  explicit virtual_board(options opt = {}) : opt_(opt), rom_(default_image()), rng_(opt.seed) { power_on(); }
 
   /**
    * Bytes @p in arrived at board time @p now. Complete frames are executed and their replies
@@ -183,8 +183,10 @@ class virtual_board {
   // --- the outside world, for tests and demos ------------------------------------------------
   /** Sets the raw 10-bit reading of AD channel @p k (0 = supply / 5); noise is added per tick. */
   void set_ad_raw(unsigned k, std::uint16_t raw) {
-    if (k == 0) battery_raw_ = raw;
-    else if (k < ram::ad_channels) ad_raw_[k] = raw;
+    if (k == 0)
+      battery_raw_ = raw;
+    else if (k < ram::ad_channels)
+      ad_raw_[k] = raw;
     update_inputs();
   }
   /** Sets the battery voltage (AD0 = V × 1024 / 25). */
@@ -228,8 +230,14 @@ class virtual_board {
     std::size_t size = 0;
   };
 
+  static const std::vector<std::uint8_t>& default_image() {
+    static const std::vector<std::uint8_t> image = default_rom();
+    return image;
+  }
   board_time period() const noexcept { return std::chrono::milliseconds(milliseconds(config().period)); }
-  std::uint16_t rom16(std::uint32_t a) const noexcept { return static_cast<std::uint16_t>(rom_[a] | (rom_[a + 1] << 8)); }
+  std::uint16_t rom16(std::uint32_t a) const noexcept {
+    return static_cast<std::uint16_t>(rom_[a] | (rom_[a + 1] << 8));
+  }
   void put16(std::uint32_t a, std::uint16_t v) noexcept {
     ram_[a] = static_cast<std::uint8_t>(v & 0xFFu);
     ram_[a + 1] = static_cast<std::uint8_t>(v >> 8);
@@ -238,9 +246,7 @@ class virtual_board {
     put16(a, static_cast<std::uint16_t>(v & 0xFFFFu));
     ram_[a + 2] = static_cast<std::uint8_t>((v >> 16) & 0xFFu);
   }
-  std::uint32_t pc() const noexcept {
-    return ram_[2] | (std::uint32_t{ram_[3]} << 8) | (std::uint32_t{ram_[4]} << 16);
-  }
+  std::uint32_t pc() const noexcept { return ram_[2] | (std::uint32_t{ram_[3]} << 8) | (std::uint32_t{ram_[4]} << 16); }
   void set_flag_bits(bool z, std::optional<bool> c) noexcept {
     auto cfg = config();
     cfg.zero_flag = z;
@@ -256,9 +262,12 @@ class virtual_board {
   void send(const reply& r, std::vector<std::uint8_t>& out) {
     const auto f = encode(r);
     out.insert(out.end(), f.begin(), f.end());
-    if (r.is_ack()) ++stats_.acks;
-    else if (r.is_nack()) ++stats_.nacks;
-    else ++stats_.data;
+    if (r.is_ack())
+      ++stats_.acks;
+    else if (r.is_nack())
+      ++stats_.nacks;
+    else
+      ++stats_.data;
   }
 
   /** Executes @p c and queues its reply; false when the board rebooted (pending input is lost). */
@@ -364,7 +373,8 @@ class virtual_board {
   outcome run(const logic& l, origin) {
     std::array<std::uint8_t, max_request_size> a{}, b{};
     const std::size_t n = l.src().size();
-    if (!read_destination(l.dst(), std::span(a).first(n)) || !read_source(l.src(), std::span(b).first(n))) return nack();
+    if (!read_destination(l.dst(), std::span(a).first(n)) || !read_source(l.src(), std::span(b).first(n)))
+      return nack();
     bool zero = true;
     for (std::size_t i = 0; i < n; ++i) {
       switch (l.op()) {
@@ -398,8 +408,7 @@ class virtual_board {
     for (int step = 0; step < (count < 0 ? -count : count); ++step) {
       if (count > 0) {  // left
         carry = (a[n - 1] & 0x80u) != 0;
-        for (std::size_t i = n; i-- > 0;)
-          a[i] = static_cast<std::uint8_t>((a[i] << 1) | (i > 0 ? (a[i - 1] >> 7) : 0));
+        for (std::size_t i = n; i-- > 0;) a[i] = static_cast<std::uint8_t>((a[i] << 1) | (i > 0 ? (a[i - 1] >> 7) : 0));
       } else {  // right
         carry = (a[0] & 1u) != 0;
         for (std::size_t i = 0; i < n; ++i)
@@ -414,15 +423,25 @@ class virtual_board {
     if (x.dst().kind() == dst_kind::com && !opt_.allow_arith_to_com) return nack();
     std::array<std::uint8_t, 2> a{}, b{};
     const std::size_t n = x.src().size();
-    if (!read_destination(x.dst(), std::span(a).first(n)) || !read_source(x.src(), std::span(b).first(n))) return nack();
+    if (!read_destination(x.dst(), std::span(a).first(n)) || !read_source(x.src(), std::span(b).first(n)))
+      return nack();
     const std::uint32_t mask = n == 1 ? 0xFFu : 0xFFFFu;
     const std::uint32_t l = a[0] | (std::uint32_t{a[1]} << 8), r = b[0] | (std::uint32_t{b[1]} << 8);
     std::uint32_t v = 0;
     bool carry = false;
     switch (x.op()) {
-      case arith_op::add: v = l + r; carry = v > mask; break;
-      case arith_op::sub: v = l - r; carry = l >= r; break;  // C = 0 on borrow (DOC-CMD)
-      case arith_op::mul: v = l * r; carry = v > mask; break;
+      case arith_op::add:
+        v = l + r;
+        carry = v > mask;
+        break;
+      case arith_op::sub:
+        v = l - r;
+        carry = l >= r;
+        break;  // C = 0 on borrow (DOC-CMD)
+      case arith_op::mul:
+        v = l * r;
+        carry = v > mask;
+        break;
       case arith_op::div:
       case arith_op::mod:
         if (r == 0) return nack();  // model: the documents do not say
@@ -565,7 +584,8 @@ class virtual_board {
       if (at + min_frame_size > rom_size) return program_error();
       const std::size_t size = rom_[at];
       if (size < min_frame_size || size > max_request_size || at + size > rom_size) return program_error();
-      const auto r = parse_command(std::span(rom_).subspan(at, size), codec_options{opt_.shift, opt_.allow_arith_to_com});
+      const auto r =
+          parse_command(std::span(rom_).subspan(at, size), codec_options{opt_.shift, opt_.allow_arith_to_com});
       if (!r.ok()) return program_error();
       ++stats_.rom_steps;
       put24(ram::program_counter.value(), static_cast<std::uint32_t>(at + size));
@@ -573,6 +593,7 @@ class virtual_board {
         set_rom_program(false);  // an error in ROM clears ROM_F and stops the program (DOC-CMD)
         return;
       }
+      if (pc() == at) return;  // a jump to itself (the idle main loop): nothing changes until the next tick
     }
   }
   void program_error() {

@@ -1,0 +1,153 @@
+// rcb4 — serves a virtual board on a pseudo-terminal or a TCP port, so any client can talk to it.
+// SPDX-License-Identifier: BSL-1.0
+//
+// One io_context thread owns the board: a reader loop feeds it the bytes of the current
+// connection and writes its replies; a tick loop advances its clock every output period so
+// motions play while nobody talks. Optional pacing delays each reply by the wire time of the
+// request and the reply (11 bits per byte at the board's current COM rate) plus a latency.
+#pragma once
+
+#include <rcb4/board/virtual_board.hpp>
+#include <rcb4/transport/pty.hpp>
+
+#include <boost/asio.hpp>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+namespace rcb4::transport {
+
+/** How the server behaves on the wire. */
+struct serve_options {
+  bool pace = false;                     ///< deliver replies at the line's byte rate
+  std::chrono::microseconds latency{0};  ///< extra delay before each reply (adapter, turnaround)
+};
+
+/** Wire time of @p bytes at @p baud with 8E1 framing (11 bits per byte). */
+constexpr std::chrono::nanoseconds wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / baud);
+}
+
+/** A virtual board served on a pty or TCP. Create with serve_pty() or serve_tcp(); run the io_context. */
+class board_server : public std::enable_shared_from_this<board_server> {
+ public:
+  using clock = std::chrono::steady_clock;
+
+  /** Serves @p board on a new pseudo-terminal; where() is its /dev/pts path. */
+  static std::shared_ptr<board_server> serve_pty(boost::asio::io_context& io, board::virtual_board& board,
+                                                 serve_options opt = {}) {
+    auto s = std::shared_ptr<board_server>(new board_server(io, board, opt));
+    s->pty_ = std::make_unique<pty_pair>();
+    s->where_ = s->pty_->path();
+    boost::asio::co_spawn(io, s->serve_pty_loop(), boost::asio::detached);
+    boost::asio::co_spawn(io, s->tick_loop(), boost::asio::detached);
+    return s;
+  }
+  /** Serves @p board on TCP @p endpoint (port 0 picks one); where() is "HOST:PORT". One client at a time. */
+  static std::shared_ptr<board_server> serve_tcp(boost::asio::io_context& io, board::virtual_board& board,
+                                                 const boost::asio::ip::tcp::endpoint& endpoint,
+                                                 serve_options opt = {}) {
+    auto s = std::shared_ptr<board_server>(new board_server(io, board, opt));
+    s->acceptor_.emplace(io, endpoint);
+    const auto local = s->acceptor_->local_endpoint();
+    s->where_ = local.address().to_string() + ":" + std::to_string(local.port());
+    boost::asio::co_spawn(io, s->accept_loop(), boost::asio::detached);
+    boost::asio::co_spawn(io, s->tick_loop(), boost::asio::detached);
+    return s;
+  }
+
+  /** Where clients connect: the pty path or "HOST:PORT". */
+  const std::string& where() const noexcept { return where_; }
+  /** Stops serving (pending operations end; the io_context can then run out). */
+  void stop() {
+    stopped_ = true;
+    boost::system::error_code ignored;
+    if (acceptor_) acceptor_->close(ignored);
+    if (pty_stream_) pty_stream_->close(ignored);
+    if (tcp_stream_) tcp_stream_->close(ignored);
+    ticker_.cancel();
+  }
+
+ private:
+  board_server(boost::asio::io_context& io, board::virtual_board& board, serve_options opt)
+      : io_(io), board_(board), opt_(opt), start_(clock::now()), ticker_(io) {}
+
+  board::board_time now() const {
+    return std::chrono::duration_cast<board::board_time>(clock::now() - start_) + epoch_;
+  }
+
+  boost::asio::awaitable<void> tick_loop() {
+    auto self = shared_from_this();
+    while (!stopped_) {
+      ticker_.expires_after(std::chrono::milliseconds(5));
+      boost::system::error_code ec;
+      co_await ticker_.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (stopped_) break;
+      board_.advance_to(now());
+    }
+  }
+
+  template <class Stream>
+  boost::asio::awaitable<void> serve_stream(Stream& stream) {
+    std::array<std::uint8_t, 512> buf{};
+    std::vector<std::uint8_t> out;
+    out.reserve(max_reply_size * 4);
+    boost::asio::steady_timer pacer(io_);
+    while (!stopped_) {
+      boost::system::error_code ec;
+      const std::size_t n = co_await stream.async_read_some(
+          boost::asio::buffer(buf), boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (ec) co_return;
+      out.clear();
+      const std::uint32_t baud = board_.line_baud();  // the rate the request travelled at
+      board_.receive(std::span(buf).first(n), now(), out);
+      if (out.empty()) continue;
+      if (opt_.pace || opt_.latency.count() > 0) {
+        auto delay = opt_.latency;
+        if (opt_.pace)
+          delay +=
+              std::chrono::duration_cast<std::chrono::microseconds>(wire_time(n, baud) + wire_time(out.size(), baud));
+        pacer.expires_after(delay);
+        co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      }
+      co_await boost::asio::async_write(stream, boost::asio::buffer(out),
+                                        boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (ec) co_return;
+    }
+  }
+
+  boost::asio::awaitable<void> serve_pty_loop() {
+    auto self = shared_from_this();
+    pty_stream_.emplace(io_, pty_->release_master());
+    co_await serve_stream(*pty_stream_);
+  }
+
+  boost::asio::awaitable<void> accept_loop() {
+    auto self = shared_from_this();
+    while (!stopped_) {
+      boost::system::error_code ec;
+      auto socket = co_await acceptor_->async_accept(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (ec) co_return;
+      socket.set_option(boost::asio::ip::tcp::no_delay(true), ec);
+      tcp_stream_.emplace(std::move(socket));
+      co_await serve_stream(*tcp_stream_);
+      tcp_stream_.reset();
+    }
+  }
+
+  boost::asio::io_context& io_;
+  board::virtual_board& board_;
+  serve_options opt_;
+  clock::time_point start_;
+  board::board_time epoch_{board_.now()};
+  boost::asio::steady_timer ticker_;
+  std::unique_ptr<pty_pair> pty_;
+  std::optional<boost::asio::posix::stream_descriptor> pty_stream_;
+  std::optional<boost::asio::ip::tcp::acceptor> acceptor_;
+  std::optional<boost::asio::ip::tcp::socket> tcp_stream_;
+  std::string where_;
+  bool stopped_ = false;
+};
+
+}  // namespace rcb4::transport
