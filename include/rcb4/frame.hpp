@@ -97,17 +97,15 @@ using reply_frame = byte_buffer<max_reply_size>;
 
 namespace detail {
 
-/** Appends bytes to a span; remembers overflow instead of writing past the end. */
+/**
+ * Appends bytes to a span. Unchecked: serialize() verifies that the span holds the command's
+ * wire_size() before writing, and the tests and fuzzers check that wire_size() is exactly what
+ * write_body() produces. (In a constant expression an overrun is a compile error.)
+ */
 class writer {
  public:
-  constexpr explicit writer(std::span<std::uint8_t> out) noexcept : out_(out) {}
-  constexpr void u8(std::uint8_t b) noexcept {
-    if (pos_ < out_.size())
-      out_[pos_] = b;
-    else
-      overflow_ = true;
-    ++pos_;
-  }
+  constexpr explicit writer(std::span<std::uint8_t> out) noexcept : out_(out.data()) {}
+  constexpr void u8(std::uint8_t b) noexcept { out_[pos_++] = b; }
   constexpr void u16(std::uint16_t v) noexcept {  // little-endian
     u8(static_cast<std::uint8_t>(v & 0xFFu));
     u8(static_cast<std::uint8_t>(v >> 8));
@@ -120,12 +118,10 @@ class writer {
     for (auto x : b) u8(x);
   }
   constexpr std::size_t position() const noexcept { return pos_; }
-  constexpr bool overflow() const noexcept { return overflow_; }
 
  private:
-  std::span<std::uint8_t> out_;
+  std::uint8_t* out_;
   std::size_t pos_ = 0;
-  bool overflow_ = false;
 };
 
 /** Reads little-endian values from a span the caller has already length-checked. */
