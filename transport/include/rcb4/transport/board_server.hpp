@@ -13,8 +13,10 @@
 #include <boost/asio.hpp>
 
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 namespace rcb4::transport {
 
@@ -22,6 +24,8 @@ namespace rcb4::transport {
 struct serve_options {
   bool pace = false;                     ///< deliver replies at the line's byte rate
   std::chrono::microseconds latency{0};  ///< extra delay before each reply (adapter, turnaround)
+  /** Fault injection for testing clients: may change, drop (clear) or extend each reply. */
+  std::function<void(std::vector<std::uint8_t>& reply)> tamper;
 };
 
 /** Wire time of @p bytes at @p baud with 8E1 framing (11 bits per byte). */
@@ -102,6 +106,7 @@ class board_server : public std::enable_shared_from_this<board_server> {
       out.clear();
       const std::uint32_t baud = board_.line_baud();  // the rate the request travelled at
       board_.receive(std::span(buf).first(n), now(), out);
+      if (opt_.tamper) opt_.tamper(out);
       if (out.empty()) continue;
       if (opt_.pace || opt_.latency.count() > 0) {
         auto delay = opt_.latency;

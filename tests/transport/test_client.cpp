@@ -1,0 +1,192 @@
+// The client against the virtual board on a real pseudo-terminal: every API form, deadlines,
+// faults on the line, many threads.
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/transport/board_server.hpp>
+#include <rcb4/transport/client.hpp>
+#include <rcb4/transport/serial.hpp>
+
+#include <boost/asio/deferred.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <boost/asio/use_future.hpp>
+#include <catch2/catch.hpp>
+
+#include <thread>
+
+using namespace rcb4;
+using namespace std::chrono_literals;
+namespace t = rcb4::transport;
+
+// Positive and negative concept checks.
+static_assert(t::AsyncByteStream<boost::asio::serial_port>);
+static_assert(t::AsyncByteStream<boost::asio::ip::tcp::socket>);
+static_assert(t::AsyncByteStream<boost::asio::posix::stream_descriptor>);
+static_assert(t::SyncByteStream<boost::asio::serial_port>);
+static_assert(!t::AsyncByteStream<int>);
+static_assert(!t::AsyncByteStream<std::vector<std::uint8_t>>);
+struct read_only {
+  using executor_type = boost::asio::any_io_executor;
+  executor_type get_executor();
+  template <class B, class H>
+  void async_read_some(B, H);
+};
+static_assert(!t::AsyncByteStream<read_only>);
+
+namespace {
+/** A virtual board served on a pty by its own thread. */
+struct served_board {
+  explicit served_board(t::serve_options so = {}, board::options bo = {}) : board(bo) {
+    server = t::board_server::serve_pty(server_io.context(), board, std::move(so));
+  }
+  ~served_board() {
+    std::promise<void> done;
+    boost::asio::post(server_io.context(), [&] {
+      server->stop();
+      done.set_value();
+    });
+    done.get_future().wait();
+  }
+  board::virtual_board board;
+  t::io_thread server_io;
+  std::shared_ptr<t::board_server> server;
+};
+
+auto open_client(t::io_thread& io, const std::string& path, t::client_options opt = {}) {
+  return t::make_client(t::open_serial(io.context(), path, 1250000), std::move(opt));
+}
+}  // namespace
+
+TEST_CASE("client: sync execute against the virtual board", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
+  const std::uint8_t bytes[] = {1, 2, 3};
+  CHECK(c.execute(move::write_ram(0x0400, bytes).value()).kind == reply_kind::ack);
+  const auto r = c.execute(move::read_ram(0x0400, 3).value());
+  CHECK(r.data.size() == 3);
+  CHECK(r.data[2] == 3);
+  std::error_code ec;
+  const auto n = c.execute(single_servo{30, 7500, 10}, ec);  // unallocated slot
+  CHECK(ec == rcb4::errc::nack);
+  CHECK(n.kind == reply_kind::nack);
+  CHECK_THROWS_AS(c.execute(single_servo{30, 7500, 10}), std::system_error);
+  CHECK(c.counters().exchanges == 6);
+}
+
+TEST_CASE("client: callback, future, coroutine and deferred completions", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  std::promise<std::error_code> p;
+  c.async_execute(ping{}, [&p](boost::system::error_code ec, t::response) { p.set_value(ec); });
+  CHECK(p.get_future().get() == std::error_code{});
+  // use_future: the error arrives as an exception, the response as the value.
+  auto f = c.async_execute(version{}, boost::asio::use_future);
+  CHECK(f.get().data.size() == 32);
+  auto fut = boost::asio::co_spawn(
+      io.context(),
+      [&c]() -> boost::asio::awaitable<std::uint16_t> {
+        auto r = co_await c.async_execute(move::read_ram(ram::pio_direction, 2).value(), boost::asio::use_awaitable);
+        co_return r.u16();
+      },
+      boost::asio::use_future);
+  CHECK(fut.get() == 0x03FF);
+  auto op = c.async_execute(ping{}, boost::asio::deferred);
+  std::promise<bool> d;
+  std::move(op)([&d](boost::system::error_code ec, t::response r) { d.set_value(!ec && r.kind == reply_kind::ack); });
+  // use_future and use_awaitable throw on error, as everywhere in Asio.
+  auto nack = c.async_execute(single_servo{30, 7500, 10}, boost::asio::use_future);
+  CHECK_THROWS_AS(nack.get(), boost::system::system_error);
+  CHECK(d.get_future().get());
+}
+
+TEST_CASE("client: a silent board times out within the deadline", "[transport]") {
+  t::pty_pair silent;  // nobody answers on the other side
+  t::io_thread io;
+  t::client_options opt;
+  opt.turnaround = 20ms;
+  auto c = open_client(io, silent.path(), opt);
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  c.execute(ping{}, ec);
+  const auto took = std::chrono::steady_clock::now() - start;
+  CHECK(ec == t::errc::timeout);
+  CHECK(c.counters().timeouts == 3);  // a ping is idempotent: 1 + 2 retries
+  CHECK(c.counters().retries == 2);
+  CHECK(took < 2s);                          // a hang check, not a speed target: 3 × (20 ms + wire time)
+  c.execute(single_servo{0, 7500, 10}, ec);  // a write is not retried
+  CHECK(ec == t::errc::timeout);
+  CHECK(c.counters().timeouts == 4);
+}
+
+TEST_CASE("client: faults on the line never turn into wrong data, and the line recovers", "[transport]") {
+  std::atomic<int> mode{0};
+  t::serve_options so;
+  so.tamper = [&mode](std::vector<std::uint8_t>& reply) {
+    switch (mode.load()) {
+      case 1: reply.clear(); break;                                          // dropped
+      case 2: reply.back() ^= 0x01; break;                                   // corrupted checksum
+      case 3: reply.insert(reply.begin(), {0xAA, 0x55}); break;              // garbage first
+      case 4: reply.insert(reply.end(), reply.begin(), reply.end()); break;  // duplicated
+      case 5: reply[2] ^= 0x10; break;                                       // a data bit flipped
+      default: break;
+    }
+  };
+  served_board b(so);
+  t::io_thread io;
+  t::client_options opt;
+  opt.turnaround = 20ms;
+  opt.read_retries = 0;
+  auto c = open_client(io, b.server->where(), opt);
+  const auto read = move::read_ram(ram::pio_direction, 2).value();
+  for (int m : {1, 2, 3, 5}) {
+    INFO("fault mode " << m);
+    mode = m;
+    std::error_code ec;
+    const auto r = c.execute(read, ec);
+    if (!ec)
+      CHECK(r.u16() == 0x03FF);  // if anything is accepted, it is the right value
+    else
+      CHECK(r.data.empty());
+    mode = 0;
+    CHECK(c.execute(read).u16() == 0x03FF);  // the next exchange starts on a clean line
+  }
+  // A duplicated reply: the copy left on the line is drained, not taken as the next reply.
+  mode = 4;
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  mode = 0;
+  CHECK(c.execute(read).u16() == 0x03FF);
+  CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
+}
+
+TEST_CASE("client: 8 threads, every reply reaches its caller", "[transport][threads]") {
+  served_board b;
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  constexpr int threads = 8, per_thread = 10000;
+  std::atomic<int> wrong{0}, failed{0};
+  std::vector<std::thread> workers;
+  for (int k = 0; k < threads; ++k) {
+    workers.emplace_back([&, k] {
+      const auto addr = ram_address::make(0x0400 + 2 * k).value();
+      for (int i = 0; i < per_thread; ++i) {
+        const std::uint16_t v = static_cast<std::uint16_t>(k * 4096 + i);
+        const std::uint8_t bytes[] = {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
+        std::error_code ec;
+        if (i % 2 == 0) {
+          c.execute(move::write_ram(addr, bytes).value(), ec);
+        } else {
+          const auto r = c.execute(move::read_ram(addr, 2).value(), ec);
+          if (!ec && r.u16() != static_cast<std::uint16_t>(v - 1)) ++wrong;
+        }
+        if (ec) ++failed;
+      }
+    });
+  }
+  for (auto& w : workers) w.join();
+  CHECK(wrong == 0);
+  CHECK(failed == 0);
+  CHECK(c.counters().exchanges == threads * per_thread);
+}

@@ -1,0 +1,353 @@
+// rcb4 — a client for any byte stream: async with any completion token, sync with deadlines.
+// SPDX-License-Identifier: BSL-1.0
+//
+//   rcb4::transport::io_thread io;                        // or run your own io_context
+//   auto c = rcb4::transport::make_client(open_serial(io.context(), "/dev/ttyUSB0", 1250000));
+//   auto r = c.execute(rcb4::move::read_ram(rcb4::ram::config, 2).value());   // sync, throws
+//   c.async_execute(rcb4::ping{}, [](boost::system::error_code ec, rcb4::transport::response r) { ... });
+//   auto r2 = co_await c.async_execute(cmd, boost::asio::use_awaitable);
+//
+// Requests from any thread queue FIFO on a strand; one exchange is on the line at a time, so the
+// bytes of two exchanges never interleave and no caller ever sees "busy". Each exchange has a
+// deadline computed from the wire (11 bits per byte at the configured baud) plus a turnaround
+// allowance. After a timeout, a bad frame or stray bytes, the next exchange first drains the line
+// until it has been quiet for a while. Idempotent reads are retried by policy.
+#pragma once
+
+#include <rcb4/rcb4.hpp>
+#include <rcb4/transport/concepts.hpp>
+#include <rcb4/transport/detail/exchange.hpp>
+#include <rcb4/transport/error.hpp>
+
+#include <boost/asio/any_completion_handler.hpp>
+#include <boost/asio/as_tuple.hpp>
+#include <boost/asio/co_spawn.hpp>
+#include <boost/asio/detached.hpp>
+#include <boost/asio/dispatch.hpp>
+#include <boost/asio/executor_work_guard.hpp>
+#include <boost/asio/experimental/awaitable_operators.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/use_awaitable.hpp>
+#include <boost/asio/write.hpp>
+
+#include <sys/ioctl.h>
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <future>
+#include <system_error>
+#include <thread>
+
+namespace rcb4::transport {
+
+/** A reply that owns its bytes (what the client hands back). */
+struct response {
+  reply_kind kind = reply_kind::ack;   ///< ACK, NACK or data
+  std::uint8_t command = 0;            ///< the echoed CMD byte
+  byte_buffer<max_reply_data> data{};  ///< data bytes (data replies)
+  /** A view as a codec reply (valid while this response lives). */
+  reply view() const noexcept {
+    switch (kind) {
+      case reply_kind::ack: return reply::ack(command);
+      case reply_kind::nack: return reply::nack(command);
+      case reply_kind::data: break;
+    }
+    return reply::data(command, data.bytes()).value();
+  }
+  /** Little-endian word at @p offset of the data. */
+  std::uint16_t u16(std::size_t offset = 0) const noexcept {
+    return static_cast<std::uint16_t>(data[offset] | (data[offset + 1] << 8));
+  }
+};
+
+/** Direction of a traced frame. */
+enum class direction : std::uint8_t { tx, rx };
+
+/** Client behaviour. */
+struct client_options {
+  std::uint32_t baud = 115200;               ///< line rate used for deadlines (the slowest is the safe default)
+  std::chrono::milliseconds turnaround{50};  ///< allowance for adapter latency and the board's answer
+  std::chrono::milliseconds quiet{5};        ///< silence that ends a drain after an error
+  unsigned read_retries = 2;                 ///< extra attempts for idempotent reads (ping, VERSION, MOV → COM)
+  bool retry_writes = false;  ///< also retry commands that change the board (only if you know they are safe)
+  /** Called with every frame on the line (direction, monotonic time, bytes). */
+  std::function<void(direction, std::chrono::steady_clock::time_point, std::span<const std::uint8_t>)> trace;
+};
+
+/** What the client has done. */
+struct client_counters {
+  std::atomic<std::uint64_t> exchanges{0};  ///< requests completed (success or not)
+  std::atomic<std::uint64_t> retries{0};    ///< extra attempts
+  std::atomic<std::uint64_t> timeouts{0};   ///< deadlines missed
+  std::atomic<std::uint64_t> errors{0};     ///< exchanges that ended in an error
+  std::atomic<std::uint64_t> bytes_out{0};  ///< bytes written
+  std::atomic<std::uint64_t> bytes_in{0};   ///< bytes read (drained bytes included)
+};
+
+/** True for commands that can be repeated without changing the board: ping, VERSION, MOV → COM. */
+inline bool is_idempotent(const command& c) noexcept {
+  if (std::holds_alternative<ping>(c) || std::holds_alternative<version>(c)) return true;
+  if (const auto* m = std::get_if<move>(&c)) return m->dst().kind() == dst_kind::com;
+  return false;
+}
+
+/** An RCB-4 client over any AsyncByteStream. */
+template <AsyncByteStream Stream>
+class basic_client {
+ public:
+  using executor_type = typename Stream::executor_type;  ///< the stream's executor
+  /**
+   * Completion signature. boost::system::error_code so that use_awaitable and use_future throw
+   * on error as everywhere in Asio; it carries rcb4::errc and transport::errc values (compare
+   * with `std::error_code(ec) == rcb4::errc::nack`).
+   */
+  using signature = void(boost::system::error_code, response);
+
+  /** A client that owns @p stream. */
+  explicit basic_client(Stream stream, client_options opt = {})
+      : stream_(std::move(stream)), opt_(std::move(opt)), strand_(stream_.get_executor()), timer_(strand_) {}
+  basic_client(const basic_client&) = delete;
+  basic_client& operator=(const basic_client&) = delete;
+
+  /**
+   * Sends @p c and completes with its reply. Errors: rcb4::errc::nack when the board refused,
+   * other rcb4::errc values for malformed replies, transport::errc::timeout / closed, or Asio's.
+   */
+  template <class Token = boost::asio::default_completion_token_t<executor_type>>
+  auto async_execute(const command& c, Token&& token = {}) {
+    return boost::asio::async_initiate<Token, signature>(
+        [this](auto handler, request r) {
+          boost::asio::dispatch(strand_, [this, r, h = std::move(handler)]() mutable {
+            queue_.push_back(pending{r, handler_type(std::move(h))});
+            if (!busy_) {
+              busy_ = true;
+              boost::asio::co_spawn(strand_, run(), boost::asio::detached);
+            }
+          });
+        },
+        token, request{encode(c), expected_reply(c), is_idempotent(c)});
+  }
+
+  /**
+   * Blocking: sends @p c and waits for its reply or its deadline. The client's executor must be
+   * run by another thread (see io_thread); from that thread it fails with errc::would_deadlock.
+   */
+  response execute(const command& c, std::error_code& ec) {
+    if (running_here()) {
+      ec = errc::would_deadlock;
+      return {};
+    }
+    std::promise<std::pair<std::error_code, response>> p;
+    auto f = p.get_future();
+    async_execute(c, [&p](boost::system::error_code e, response r) { p.set_value({std::error_code(e), r}); });
+    auto [e, r] = f.get();
+    ec = e;
+    return r;
+  }
+  /** Blocking; throws std::system_error on any error (a NACK included). */
+  response execute(const command& c) {
+    std::error_code ec;
+    auto r = execute(c, ec);
+    if (ec) throw std::system_error(ec, "rcb4");
+    return r;
+  }
+
+  /** The stream (for settings such as the baud rate; do not read or write it directly). */
+  Stream& stream() noexcept { return stream_; }
+  /** The options; change them only while no exchange runs. */
+  client_options& options() noexcept { return opt_; }
+  /** What the client has done so far. */
+  const client_counters& counters() const noexcept { return counters_; }
+  /** The strand all exchanges run on. */
+  executor_type get_executor() const noexcept { return stream_.get_executor(); }
+
+ private:
+  struct request {
+    request_frame frame;
+    reply_shape shape;
+    bool idempotent;
+  };
+  using handler_type = boost::asio::any_completion_handler<signature>;
+  struct pending {
+    request req;
+    handler_type handler;
+  };
+
+  bool running_here() const {
+    if constexpr (requires { stream_.get_executor().running_in_this_thread(); })
+      return stream_.get_executor().running_in_this_thread();
+    else
+      return false;
+  }
+
+  /** Bytes already waiting on the line (0 when the stream cannot tell). */
+  std::size_t bytes_waiting() {
+    if constexpr (requires(boost::system::error_code & e) { stream_.available(e); }) {
+      boost::system::error_code e;
+      return stream_.available(e);
+    } else if constexpr (requires {
+                           { stream_.native_handle() } -> std::convertible_to<int>;
+                         }) {
+      int n = 0;  // serial ports and descriptors: ask the driver
+      return ::ioctl(stream_.native_handle(), FIONREAD, &n) == 0 && n > 0 ? static_cast<std::size_t>(n) : 0;
+    } else {
+      return 0;
+    }
+  }
+
+  std::chrono::steady_clock::duration budget(const request& r) const {
+    const auto bytes = r.frame.size() + r.shape.frame_size();
+    return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / opt_.baud) +
+           opt_.turnaround;
+  }
+
+  void trace(direction d, std::span<const std::uint8_t> b) {
+    if (opt_.trace && !b.empty()) opt_.trace(d, std::chrono::steady_clock::now(), b);
+  }
+
+  boost::asio::awaitable<void> run() {
+    while (!queue_.empty()) {
+      pending p = std::move(queue_.front());
+      queue_.pop_front();
+      response r;
+      const std::error_code ec = co_await perform(p.req, r);
+      ++counters_.exchanges;
+      if (ec) ++counters_.errors;
+      auto ex = boost::asio::get_associated_executor(p.handler, strand_);
+      boost::asio::dispatch(
+          ex, [h = std::move(p.handler), ec, r]() mutable { std::move(h)(boost::system::error_code(ec), r); });
+    }
+    busy_ = false;
+  }
+
+  /** Reads and discards until the line has been quiet for opt_.quiet. */
+  boost::asio::awaitable<std::error_code> drain() {
+    using namespace boost::asio::experimental::awaitable_operators;
+    std::array<std::uint8_t, 256> junk{};
+    for (;;) {
+      timer_.expires_after(opt_.quiet);
+      auto res = co_await (
+          stream_.async_read_some(boost::asio::buffer(junk), boost::asio::as_tuple(boost::asio::use_awaitable)) ||
+          timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
+      if (res.index() == 1) break;  // quiet
+      auto [e, n] = std::get<0>(res);
+      if (e) co_return e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
+      counters_.bytes_in += n;
+      trace(direction::rx, std::span(junk).first(n));
+    }
+    dirty_ = false;
+    co_return std::error_code{};
+  }
+
+  boost::asio::awaitable<std::error_code> perform(const request& req, response& out) {
+    using namespace boost::asio::experimental::awaitable_operators;
+    const unsigned attempts = 1 + ((req.idempotent || opt_.retry_writes) ? opt_.read_retries : 0);
+    std::error_code ec;
+    for (unsigned attempt = 0; attempt < attempts; ++attempt) {
+      if (attempt > 0) ++counters_.retries;
+      if (bytes_waiting() > 0) dirty_ = true;  // stray bytes (a late or duplicated reply)
+      if (dirty_) {
+        ec = co_await drain();
+        if (ec) co_return ec;
+      }
+      detail::exchange ex(req.frame.bytes(), req.shape);
+      timer_.expires_after(budget(req));
+      trace(direction::tx, req.frame.bytes());
+      bool timed_out = false;
+      while (ex.next() != detail::exchange::step::done && !ec && !timed_out) {
+        if (ex.next() == detail::exchange::step::write) {
+          auto res = co_await (boost::asio::async_write(stream_,
+                                                        boost::asio::buffer(ex.to_write().data(), ex.to_write().size()),
+                                                        boost::asio::as_tuple(boost::asio::use_awaitable)) ||
+                               timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
+          if (res.index() == 1) {
+            timed_out = true;
+            break;
+          }
+          auto [e, n] = std::get<0>(res);
+          counters_.bytes_out += n;
+          ex.wrote(n);
+          if (e) ec = e;
+        } else {
+          const auto buf = ex.read_buffer();
+          auto res = co_await (stream_.async_read_some(boost::asio::buffer(buf.data(), buf.size()),
+                                                       boost::asio::as_tuple(boost::asio::use_awaitable)) ||
+                               timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
+          if (res.index() == 1) {
+            timed_out = true;
+            break;
+          }
+          auto [e, n] = std::get<0>(res);
+          counters_.bytes_in += n;
+          trace(direction::rx, buf.first(n));
+          if (n > 0) ex.received(n);
+          if (e) ec = e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
+        }
+      }
+      if (ec) {
+        dirty_ = true;
+        co_return ec;  // the line itself failed: no retry here
+      }
+      if (timed_out) {
+        ++counters_.timeouts;
+        dirty_ = true;
+        ec = errc::timeout;
+        continue;
+      }
+      const auto& r = ex.result();
+      if (r.status == parse_status::error) {
+        dirty_ = true;  // stray or corrupted bytes: resync before the next exchange
+        ec = r.error;
+        continue;
+      }
+      out.kind = r.value.kind();
+      out.command = r.value.command();
+      out.data = byte_buffer<max_reply_data>(r.value.bytes());
+      co_return out.kind == reply_kind::nack ? std::error_code(rcb4::errc::nack) : std::error_code{};
+    }
+    co_return ec;
+  }
+
+  Stream stream_;
+  client_options opt_;
+  boost::asio::strand<executor_type> strand_;
+  boost::asio::steady_timer timer_;
+  std::deque<pending> queue_;
+  bool busy_ = false;
+  bool dirty_ = false;
+  client_counters counters_;
+};
+
+/** A client for @p stream, deducing the stream type. */
+template <AsyncByteStream Stream>
+basic_client<Stream> make_client(Stream stream, client_options opt = {}) {
+  return basic_client<Stream>(std::move(stream), std::move(opt));
+}
+
+/** An io_context with its own thread, for the blocking API. Joins on destruction. */
+class io_thread {
+ public:
+  /** Starts the thread. */
+  io_thread() : work_(io_.get_executor()), thread_([this] { io_.run(); }) {}
+  io_thread(const io_thread&) = delete;
+  io_thread& operator=(const io_thread&) = delete;
+  /** Stops the context and joins the thread. */
+  ~io_thread() {
+    work_.reset();
+    io_.stop();
+    thread_.join();
+  }
+  /** The context the thread runs. */
+  boost::asio::io_context& context() noexcept { return io_; }
+
+ private:
+  boost::asio::io_context io_;
+  boost::asio::executor_work_guard<boost::asio::io_context::executor_type> work_;
+  std::thread thread_;
+};
+
+}  // namespace rcb4::transport
