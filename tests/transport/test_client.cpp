@@ -190,3 +190,22 @@ TEST_CASE("client: 8 threads, every reply reaches its caller", "[transport][thre
   CHECK(failed == 0);
   CHECK(c.counters().exchanges == threads * per_thread);
 }
+
+TEST_CASE("client: destroying a client with exchanges in flight ends them, no hang", "[transport]") {
+  t::pty_pair silent;
+  t::io_thread io;
+  std::promise<boost::system::error_code> first, second;
+  const auto start = std::chrono::steady_clock::now();
+  {
+    t::client_options opt;
+    opt.turnaround = 10s;  // the deadline is far away: only the destructor can end these
+    auto c = open_client(io, silent.path(), opt);
+    c.async_execute(ping{}, [&](boost::system::error_code ec, t::response) { first.set_value(ec); });
+    c.async_execute(ping{}, [&](boost::system::error_code ec, t::response) { second.set_value(ec); });
+  }
+  const auto e1 = first.get_future().get();
+  const auto e2 = second.get_future().get();
+  CHECK(e1);
+  CHECK(std::error_code(e2) == t::errc::cancelled);
+  CHECK(std::chrono::steady_clock::now() - start < 5s);
+}

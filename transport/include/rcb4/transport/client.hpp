@@ -112,6 +112,29 @@ class basic_client {
       : stream_(std::move(stream)), opt_(std::move(opt)), strand_(stream_.get_executor()), timer_(strand_) {}
   basic_client(const basic_client&) = delete;
   basic_client& operator=(const basic_client&) = delete;
+  /**
+   * Closes the stream. If an exchange is still in flight and this is not the executor's thread,
+   * waits until the worker has left (it ends quickly: the close cancels its I/O). Requests still
+   * queued then fail with errc::cancelled.
+   */
+  ~basic_client() {
+    if (running_here()) return;  // the executor's own thread: nothing can be in flight concurrently
+    std::promise<void> idle;
+    auto done = idle.get_future();
+    boost::asio::dispatch(strand_, [this, &idle] {
+      closing_ = true;
+      boost::system::error_code ignored;
+      stream_.close(ignored);
+      timer_.cancel();
+      for (auto& p : queue_) complete(std::move(p.handler), errc::cancelled, response{});
+      queue_.clear();
+      if (busy_)
+        idle_ = &idle;
+      else
+        idle.set_value();
+    });
+    done.wait();
+  }
 
   /**
    * Sends @p c and completes with its reply. Errors: rcb4::errc::nack when the board refused,
@@ -210,18 +233,36 @@ class basic_client {
   }
 
   boost::asio::awaitable<void> run() {
-    while (!queue_.empty()) {
+    for (;;) {
       pending p = std::move(queue_.front());
       queue_.pop_front();
       response r;
       const std::error_code ec = co_await perform(p.req, r);
       ++counters_.exchanges;
       if (ec) ++counters_.errors;
-      auto ex = boost::asio::get_associated_executor(p.handler, strand_);
-      boost::asio::dispatch(
-          ex, [h = std::move(p.handler), ec, r]() mutable { std::move(h)(boost::system::error_code(ec), r); });
+      const bool more = !queue_.empty() && !closing_;
+      if (!more) finish_worker();
+      // Completing the handler is the last touch of `this`: its caller may destroy the client.
+      complete(std::move(p.handler), ec, r);
+      if (!more) co_return;
     }
+  }
+
+  /**
+   * Queues @p h's completion on the strand, where it runs only once the worker has suspended or
+   * finished, then on the handler's own executor.
+   */
+  void complete(handler_type h, std::error_code ec, const response& r) {
+    boost::asio::post(strand_, [h = std::move(h), ec, r, s = strand_]() mutable {
+      auto ex = boost::asio::get_associated_executor(h, s);
+      boost::asio::dispatch(ex,
+                            [h = std::move(h), ec, r]() mutable { std::move(h)(boost::system::error_code(ec), r); });
+    });
+  }
+
+  void finish_worker() {
     busy_ = false;
+    if (idle_) idle_->set_value();
   }
 
   /** Reads and discards until the line has been quiet for opt_.quiet. */
@@ -319,6 +360,8 @@ class basic_client {
   std::deque<pending> queue_;
   bool busy_ = false;
   bool dirty_ = false;
+  bool closing_ = false;
+  std::promise<void>* idle_ = nullptr;
   client_counters counters_;
 };
 

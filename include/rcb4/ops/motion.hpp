@@ -1,0 +1,157 @@
+// rcb4 — motions stored in ROM: play, status, stop (protocol.md §8).
+// SPDX-License-Identifier: BSL-1.0
+//
+// Play is KONDO's four steps on a freshly read config word: suspend the ROM program, reset the
+// program counter to the layout's main loop, CALL the motion, resume. The layout (HTH4 1.3,
+// 2.0–2.1, 2.2+) says where the main loop and the motions are.
+#pragma once
+
+#include <rcb4/ops/operation.hpp>
+
+#include <array>
+
+namespace rcb4::ops {
+
+/** What happens to the servos while the program is switched (the sources differ, §11.14). */
+enum class servo_power : std::uint8_t {
+  keep,     ///< leave the ICS switch on: a standing robot stays standing (KONDO's Arduino library)
+  release,  ///< switch ICS off during the change, as KONDO's Python library does
+};
+
+namespace detail {
+inline std::array<std::uint8_t, 2> le(std::uint16_t v) noexcept {
+  return {static_cast<std::uint8_t>(v & 0xFFu), static_cast<std::uint8_t>(v >> 8)};
+}
+}  // namespace detail
+
+/** Plays motion @p n (1-based) of @p layout. value(): the config word it resumed with. */
+class play_motion {
+ public:
+  /** Motion @p n of @p layout; an impossible number shows in error() at once. */
+  explicit play_motion(unsigned n, const rom_layout& layout = hth4_2_2, servo_power power = servo_power::keep)
+      : layout_(layout), power_(power) {
+    auto a = motion_address(layout, n);
+    if (!a)
+      error_ = a.error();
+    else
+      target_ = *a;
+    const std::uint32_t pc = layout.main_loop.value();
+    reset_ = {static_cast<std::uint8_t>(pc & 0xFFu), static_cast<std::uint8_t>((pc >> 8) & 0xFFu),
+              static_cast<std::uint8_t>((pc >> 16) & 0xFFu)};
+  }
+  /** The next step. */
+  std::optional<command> next() {
+    if (error_ != errc{}) return std::nullopt;
+    switch (step_) {
+      case 0: return command{move::read_ram(ram::config, 2).value()};
+      case 1: return command{move::write_ram(ram::config, suspend_).value()};
+      case 2: return command{move::write_ram(ram::program_counter, reset_).value()};
+      case 3: return command{call{target_}};
+      case 4: return command{move::write_ram(ram::config, resume_).value()};
+      default: return std::nullopt;
+    }
+  }
+  /** Takes a reply. */
+  void on_reply(const reply& r) {
+    if ((error_ = detail::check_reply(r, step_ == 0, 2)) != errc{}) return;
+    if (step_ == 0) {
+      auto c = config_word::decode(r.u16());
+      c.rom_program = c.vector_jump = c.interpolation_message = false;
+      if (power_ == servo_power::release) c.ics_enabled = false;
+      suspend_ = detail::le(c.encode());
+      c.rom_program = c.vector_jump = c.ics_enabled = true;
+      resumed_ = c.encode();
+      resume_ = detail::le(resumed_);
+    }
+    ++step_;
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return error_; }
+  /** The config word written at the end. */
+  std::uint16_t value() const noexcept { return resumed_; }
+
+ private:
+  rom_layout layout_;
+  servo_power power_;
+  rom_address target_{};
+  std::array<std::uint8_t, 2> suspend_{}, resume_{};
+  std::array<std::uint8_t, 10> reset_{};
+  std::uint16_t resumed_ = 0;
+  unsigned step_ = 0;
+  errc error_{};
+};
+
+/** Whether a motion runs, and which (protocol.md §8.2). */
+struct motion_state {
+  bool running = false;               ///< a CALL is pending (stack or update flags busy)
+  std::optional<unsigned> motion;     ///< its number under the layout, when the PC is in a motion slot
+  std::uint32_t program_counter = 0;  ///< where the ROM program is
+  friend bool operator==(const motion_state&, const motion_state&) = default;
+};
+
+/** Reads the program counter block (10 bytes at 0x0002) and decodes the motion state. */
+class read_motion_state {
+ public:
+  /** For motions laid out as @p layout. */
+  explicit read_motion_state(const rom_layout& layout = hth4_2_2) : layout_(layout) {}
+  /** The read, once. */
+  std::optional<command> next() {
+    if (done_ || error_ != errc{}) return std::nullopt;
+    return command{move::read_ram(ram::program_counter, 10).value()};
+  }
+  /** Takes the reply. */
+  void on_reply(const reply& r) {
+    done_ = true;
+    if ((error_ = detail::check_reply(r, true, 10)) != errc{}) return;
+    const auto b = r.bytes();
+    state_.program_counter = b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16);
+    state_.running = (b[3] | b[4] | b[5] | b[6] | b[7]) != 0;  // SP, unused, first update flags
+    const std::uint32_t base = layout_.motion_base.value();
+    if (state_.running && state_.program_counter >= base) {
+      const std::uint32_t n = (state_.program_counter - base) / layout_.slot_size + 1;
+      if (n <= layout_.motion_count) state_.motion = n;
+    }
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return error_; }
+  /** The state read. */
+  const motion_state& value() const noexcept { return state_; }
+
+ private:
+  rom_layout layout_;
+  bool done_ = false;
+  motion_state state_{};
+  errc error_{};
+};
+
+/** Stops the ROM program (a running motion halts where it is): config bits 1 and 3 cleared. */
+class stop_motion {
+ public:
+  /** Read the config word, then write it back suspended. */
+  std::optional<command> next() {
+    if (error_ != errc{} || step_ > 1) return std::nullopt;
+    if (step_ == 0) return command{move::read_ram(ram::config, 2).value()};
+    return command{move::write_ram(ram::config, word_).value()};
+  }
+  /** Takes a reply. */
+  void on_reply(const reply& r) {
+    if ((error_ = detail::check_reply(r, step_ == 0, 2)) != errc{}) return;
+    if (step_ == 0) {
+      auto c = config_word::decode(r.u16());
+      c.rom_program = c.vector_jump = false;
+      word_ = detail::le(c.encode());
+    }
+    ++step_;
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return error_; }
+  /** The config word written. */
+  std::uint16_t value() const noexcept { return static_cast<std::uint16_t>(word_[0] | (word_[1] << 8)); }
+
+ private:
+  std::array<std::uint8_t, 2> word_{};
+  unsigned step_ = 0;
+  errc error_{};
+};
+
+}  // namespace rcb4::ops
