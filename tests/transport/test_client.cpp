@@ -3,7 +3,10 @@
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
+#include <rcb4/transport/detect.hpp>
+#include <rcb4/transport/operations.hpp>
 #include <rcb4/transport/serial.hpp>
+#include <rcb4/transport/tcp.hpp>
 
 #include <boost/asio/deferred.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -11,6 +14,9 @@
 #include <boost/asio/use_future.hpp>
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <thread>
 
 using namespace rcb4;
@@ -208,4 +214,66 @@ TEST_CASE("client: destroying a client with exchanges in flight ends them, no ha
   CHECK(e1);
   CHECK(std::error_code(e2) == t::errc::cancelled);
   CHECK(std::chrono::steady_clock::now() - start < 5s);
+}
+
+TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[transport][ser2net]") {
+  if (std::system("command -v ser2net > /dev/null 2>&1") != 0) {
+    WARN("ser2net is not installed (cmake/install-deps.sh installs it): skipped");
+    return;
+  }
+  served_board b;
+  // A free loopback port: bind to 0, read it, release it for ser2net.
+  boost::asio::io_context probe;
+  boost::asio::ip::tcp::acceptor a(probe, {boost::asio::ip::make_address("127.0.0.1"), 0});
+  const auto port = a.local_endpoint().port();
+  a.close();
+  const std::string dir = std::filesystem::temp_directory_path() / ("rcb4-ser2net-" + std::to_string(port));
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream cfg(dir + "/ser2net.yaml");
+    cfg << "connection: &rcb4\n  accepter: tcp,127.0.0.1," << port << "\n  connector: serialdev," << b.server->where()
+        << ",115200e81,local\n  options:\n    kickolduser: true\n";
+  }
+  const std::string cmd = "ser2net -n -d -c " + dir + "/ser2net.yaml -P " + dir + "/pid > " + dir +
+                          "/log 2>&1 & echo $! > " + dir + "/child";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  t::io_thread io;
+  std::error_code ec;
+  boost::asio::ip::tcp::socket s(io.context());
+  for (int i = 0; i < 100; ++i) {  // ser2net needs a moment to listen; bounded
+    s = t::connect(io.context(), "127.0.0.1:" + std::to_string(port), ec);
+    if (!ec) break;
+    std::this_thread::sleep_for(20ms);
+  }
+  REQUIRE_FALSE(ec);
+  {
+    auto c = t::make_client(std::move(s));
+    CHECK(c.execute(ping{}).kind == reply_kind::ack);
+    CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
+    CHECK(t::run(c, ops::read_analog{}).battery_volts == Approx(10.8).margin(0.1));
+  }
+  std::system(("kill $(cat " + dir + "/child) 2>/dev/null").c_str());
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("client: operations run on the client; baud detection; bad addresses", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  std::error_code ec;
+  CHECK(t::detect_baud(io.context(), b.server->where(), ec) == 1250000);  // a pty answers at the first rate
+  CHECK_FALSE(ec);
+  CHECK(t::detect_baud(io.context(), "/dev/does-not-exist", ec) == 0);
+  CHECK(ec == std::errc::no_such_file_or_directory);
+  auto c = open_client(io, b.server->where());
+  const auto states = t::run(c, ops::read_servo_states{});
+  CHECK(states.size() == 22);
+  auto fut = boost::asio::co_spawn(io.context(), t::async_run(c, ops::read_motion_state{}), boost::asio::use_future);
+  CHECK_FALSE(fut.get().running);
+  ops::read_memory bad(ops::memory::ram, 0x0480, 32);
+  t::run(c, bad, ec);
+  CHECK(ec == rcb4::errc::ram_address_out_of_range);
+  t::connect(io.context(), "no-port", ec);
+  CHECK(ec);
+  t::connect(io.context(), "127.0.0.1:1", ec);  // nothing listens there
+  CHECK(ec);
 }

@@ -116,6 +116,9 @@ inline boost::asio::serial_port open_serial(boost::asio::io_context& io, const s
   return port;
 }
 
+/** The rates the RCB-4 speaks, in the order detection tries them (HTH4 projects favour 1.25 M). */
+inline constexpr std::uint32_t board_bauds[] = {1250000, 115200, 625000};
+
 /** open_serial that throws std::system_error. */
 inline boost::asio::serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
                                             serial_info* info = nullptr) {

@@ -1,0 +1,42 @@
+// rcb4 — reaching a board through TCP, e.g. a serial port exported by ser2net.
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <boost/asio/connect.hpp>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+
+#include <string>
+#include <system_error>
+
+namespace rcb4::transport {
+
+/** Connects to "HOST:PORT" (names resolved; IPv6 as "[::1]:3333"), with TCP_NODELAY set. */
+inline boost::asio::ip::tcp::socket connect(boost::asio::io_context& io, const std::string& where,
+                                            std::error_code& ec) {
+  boost::asio::ip::tcp::socket socket(io);
+  const auto colon = where.rfind(':');
+  if (colon == std::string::npos || colon + 1 == where.size()) {
+    ec = std::make_error_code(std::errc::invalid_argument);
+    return socket;
+  }
+  std::string host = where.substr(0, colon);
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  boost::asio::ip::tcp::resolver resolver(io);
+  boost::system::error_code bec;
+  const auto endpoints = resolver.resolve(host, where.substr(colon + 1), bec);
+  if (!bec) boost::asio::connect(socket, endpoints, bec);
+  if (!bec) socket.set_option(boost::asio::ip::tcp::no_delay(true), bec);
+  ec = bec;
+  return socket;
+}
+
+/** connect() that throws std::system_error. */
+inline boost::asio::ip::tcp::socket connect(boost::asio::io_context& io, const std::string& where) {
+  std::error_code ec;
+  auto s = connect(io, where, ec);
+  if (ec) throw std::system_error(ec, "connect " + where);
+  return s;
+}
+
+}  // namespace rcb4::transport
