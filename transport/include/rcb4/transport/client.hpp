@@ -21,11 +21,12 @@
 
 #include <boost/asio/any_completion_handler.hpp>
 #include <boost/asio/as_tuple.hpp>
+#include <boost/asio/bind_cancellation_slot.hpp>
+#include <boost/asio/cancellation_signal.hpp>
 #include <boost/asio/co_spawn.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/executor_work_guard.hpp>
-#include <boost/asio/experimental/awaitable_operators.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
@@ -265,17 +266,33 @@ class basic_client {
     if (idle_) idle_->set_value();
   }
 
+  /** Starts the exchange's deadline: when it expires, the pending read or write is cancelled. */
+  void arm(std::chrono::steady_clock::duration d) {
+    timed_out_ = false;
+    const auto gen = ++generation_;
+    timer_.expires_after(d);
+    timer_.async_wait([this, gen](boost::system::error_code ec) {
+      if (ec || gen != generation_) return;  // cancelled, or a stale timer of an earlier exchange
+      timed_out_ = true;
+      cancel_.emit(boost::asio::cancellation_type::terminal);
+    });
+  }
+  void disarm() {
+    ++generation_;
+    timer_.cancel();
+  }
+  auto token() {
+    return boost::asio::bind_cancellation_slot(cancel_.slot(), boost::asio::as_tuple(boost::asio::use_awaitable));
+  }
+
   /** Reads and discards until the line has been quiet for opt_.quiet. */
   boost::asio::awaitable<std::error_code> drain() {
-    using namespace boost::asio::experimental::awaitable_operators;
     std::array<std::uint8_t, 256> junk{};
     for (;;) {
-      timer_.expires_after(opt_.quiet);
-      auto res = co_await (
-          stream_.async_read_some(boost::asio::buffer(junk), boost::asio::as_tuple(boost::asio::use_awaitable)) ||
-          timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
-      if (res.index() == 1) break;  // quiet
-      auto [e, n] = std::get<0>(res);
+      arm(opt_.quiet);
+      auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(junk), token());
+      disarm();
+      if (timed_out_) break;  // quiet
       if (e) co_return e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
       counters_.bytes_in += n;
       trace(direction::rx, std::span(junk).first(n));
@@ -285,7 +302,6 @@ class basic_client {
   }
 
   boost::asio::awaitable<std::error_code> perform(const request& req, response& out) {
-    using namespace boost::asio::experimental::awaitable_operators;
     const unsigned attempts = 1 + ((req.idempotent || opt_.retry_writes) ? opt_.read_retries : 0);
     std::error_code ec;
     for (unsigned attempt = 0; attempt < attempts; ++attempt) {
@@ -296,44 +312,30 @@ class basic_client {
         if (ec) co_return ec;
       }
       detail::exchange ex(req.frame.bytes(), req.shape);
-      timer_.expires_after(budget(req));
       trace(direction::tx, req.frame.bytes());
-      bool timed_out = false;
-      while (ex.next() != detail::exchange::step::done && !ec && !timed_out) {
+      arm(budget(req));
+      while (ex.next() != detail::exchange::step::done && !ec && !timed_out_) {
         if (ex.next() == detail::exchange::step::write) {
-          auto res = co_await (boost::asio::async_write(stream_,
-                                                        boost::asio::buffer(ex.to_write().data(), ex.to_write().size()),
-                                                        boost::asio::as_tuple(boost::asio::use_awaitable)) ||
-                               timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
-          if (res.index() == 1) {
-            timed_out = true;
-            break;
-          }
-          auto [e, n] = std::get<0>(res);
+          const auto w = ex.to_write();
+          auto [e, n] = co_await boost::asio::async_write(stream_, boost::asio::buffer(w.data(), w.size()), token());
           counters_.bytes_out += n;
           ex.wrote(n);
-          if (e) ec = e;
+          if (e && !timed_out_) ec = e;
         } else {
           const auto buf = ex.read_buffer();
-          auto res = co_await (stream_.async_read_some(boost::asio::buffer(buf.data(), buf.size()),
-                                                       boost::asio::as_tuple(boost::asio::use_awaitable)) ||
-                               timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable)));
-          if (res.index() == 1) {
-            timed_out = true;
-            break;
-          }
-          auto [e, n] = std::get<0>(res);
+          auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(buf.data(), buf.size()), token());
           counters_.bytes_in += n;
           trace(direction::rx, buf.first(n));
           if (n > 0) ex.received(n);
-          if (e) ec = e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
+          if (e && !timed_out_) ec = e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
         }
       }
+      disarm();
       if (ec) {
         dirty_ = true;
         co_return ec;  // the line itself failed: no retry here
       }
-      if (timed_out) {
+      if (timed_out_) {
         ++counters_.timeouts;
         dirty_ = true;
         ec = errc::timeout;
@@ -361,6 +363,9 @@ class basic_client {
   bool busy_ = false;
   bool dirty_ = false;
   bool closing_ = false;
+  bool timed_out_ = false;
+  std::uint64_t generation_ = 0;
+  boost::asio::cancellation_signal cancel_;
   std::promise<void>* idle_ = nullptr;
   client_counters counters_;
 };

@@ -1,0 +1,161 @@
+// Transport benchmarks, printed side by side in one run (never asserted):
+//  - exchanges per second for ping, a 2-byte MOV read and CONST36 over a pty against the virtual
+//    board, next to a raw pty echo floor (target ≥ 0.9× the floor);
+//  - a control cycle (read every servo's state + write 36 servos) against the board paced at
+//    1.25 Mbaud, next to the wire limit of those bytes (target ≥ 0.97×);
+//  - heap allocations per exchange in steady state (target 0).
+// SPDX-License-Identifier: BSL-1.0
+#include "alloc_count.hpp"
+
+#include <rcb4/transport/board_server.hpp>
+#include <rcb4/transport/client.hpp>
+#include <rcb4/transport/operations.hpp>
+#include <rcb4/transport/serial.hpp>
+
+#include <cstdio>
+
+namespace {
+using namespace rcb4;
+namespace t = rcb4::transport;
+using clock_type = std::chrono::steady_clock;
+
+double us_since(clock_type::time_point start, int n) {
+  return std::chrono::duration<double, std::micro>(clock_type::now() - start).count() / n;
+}
+
+/** Round trips of a raw echo on a pty: the floor for any pty server. */
+double echo_floor(std::size_t bytes, int n) {
+  boost::asio::io_context io;
+  t::pty_pair pty;
+  boost::asio::posix::stream_descriptor master(io, pty.release_master());
+  std::array<std::uint8_t, 512> buf{};
+  std::function<void()> loop = [&] {
+    master.async_read_some(boost::asio::buffer(buf), [&](boost::system::error_code ec, std::size_t got) {
+      if (ec) return;
+      boost::asio::async_write(master, boost::asio::buffer(buf.data(), got),
+                               [&](boost::system::error_code e, std::size_t) {
+                                 if (!e) loop();
+                               });
+    });
+  };
+  loop();
+  std::thread th([&] { io.run(); });
+  const int fd = ::open(pty.path().c_str(), O_RDWR | O_NOCTTY);
+  termios tio{};
+  ::tcgetattr(fd, &tio);
+  ::cfmakeraw(&tio);
+  ::tcsetattr(fd, TCSANOW, &tio);
+  std::vector<std::uint8_t> req(bytes, 0x55), rep(bytes);
+  const auto start = clock_type::now();
+  for (int i = 0; i < n; ++i) {
+    if (::write(fd, req.data(), req.size()) < 0) break;
+    std::size_t got = 0;
+    while (got < bytes) {
+      const auto r = ::read(fd, rep.data() + got, bytes - got);
+      if (r <= 0) break;
+      got += static_cast<std::size_t>(r);
+    }
+  }
+  const double us = us_since(start, n);
+  ::close(fd);
+  boost::asio::post(io, [&] { master.close(); });
+  th.join();
+  return us;
+}
+
+struct served {
+  explicit served(t::serve_options so = {}, board::options bo = {}) : board(bo) {
+    server = t::board_server::serve_pty(io.context(), board, so);
+  }
+  ~served() {
+    std::promise<void> p;
+    boost::asio::post(io.context(), [&] {
+      server->stop();
+      p.set_value();
+    });
+    p.get_future().wait();
+  }
+  board::virtual_board board;
+  t::io_thread io;
+  std::shared_ptr<t::board_server> server;
+};
+}  // namespace
+
+int main() {
+  const int n = 20000;
+  std::printf("rcb4 transport benchmarks (%d exchanges each; pty, virtual board unpaced)\n", n);
+  servo_set<servo_position> all36;
+  for (int i = 0; i < 36; ++i) all36.insert(ics_number::make(i).value(), 7600);
+  const command cmds[] = {ping{}, move::read_ram(0x0090, 2).value(), const_servo::make(all36, 10).value()};
+  const char* names[] = {"ping", "MOV read 2 bytes", "CONST36"};
+  {
+    served b;
+    t::io_thread io;
+    auto c = t::make_client(t::open_serial(io.context(), b.server->where(), 1250000));
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto req = wire_size(cmds[k]), rep = expected_reply(cmds[k]).frame_size();
+      const double floor_us = echo_floor(std::max(req, rep), n / 4);
+      for (int i = 0; i < 100; ++i) c.execute(cmds[k]);  // warm up
+      const auto allocs = bench::allocations();
+      const auto start = clock_type::now();
+      for (int i = 0; i < n; ++i) c.execute(cmds[k]);
+      const double us = us_since(start, n);
+      const double per = static_cast<double>(bench::allocations() - allocs) / n;
+      std::printf(
+          "  %-18s %8.0f exchanges/s (%6.2f us)   raw echo floor %8.0f/s   = %.2fx (target >= 0.9)   %.1f "
+          "allocs/exchange (sync API)\n",
+          names[k], 1e6 / us, us, 1e6 / floor_us, floor_us / us, per);
+    }
+    // The async API with a callback, for its allocation count.
+    std::atomic<int> left{n};
+    std::promise<void> all_done;
+    const auto allocs = bench::allocations();
+    const auto start = clock_type::now();
+    std::function<void()> next = [&] {
+      c.async_execute(cmds[0], [&](boost::system::error_code, t::response) {
+        if (--left == 0)
+          all_done.set_value();
+        else
+          next();
+      });
+    };
+    next();
+    all_done.get_future().wait();
+    std::printf("  %-18s %8.0f exchanges/s (%6.2f us)   %.1f allocs/exchange (async API, callback)\n", "ping (async)",
+                1e6 / us_since(start, n), us_since(start, n), static_cast<double>(bench::allocations() - allocs) / n);
+  }
+  {
+    // Control cycle at 1.25 Mbaud, paced: read all servo states (planned) + CONST to 36 servos.
+    t::serve_options so;
+    so.pace = true;
+    board::options bo;
+    bo.servo_count = 35;
+    served b(so, bo);
+    t::io_thread io;
+    t::client_options co;
+    co.baud = 1250000;
+    auto c = t::make_client(t::open_serial(io.context(), b.server->where(), 1250000), co);
+    const auto cost = ops::link_cost::at(1250000, std::chrono::microseconds(25));
+    std::size_t wire_bytes = 0;
+    ops::read_servo_states probe(cost);
+    std::error_code ec;
+    t::run(c, probe, ec);
+    wire_bytes += 10 + 73;  // the allocation-table read
+    for (const auto& r : probe.plan()) wire_bytes += 10 + r.size + 3;
+    wire_bytes += wire_size(cmds[2]) + 4;
+    const int cycles = 300;
+    const auto start = clock_type::now();
+    for (int i = 0; i < cycles; ++i) {
+      t::run(c, ops::read_servo_states(cost));
+      c.execute(cmds[2]);
+    }
+    const double us = us_since(start, cycles);
+    const double limit_us = static_cast<double>(wire_bytes) * 11.0 / 1.25;  // 11 bits per byte at 1.25 Mbaud
+    std::printf("\ncontrol cycle at 1.25 Mbaud (paced board): read %zu servos in %zu exchanges + CONST36\n",
+                probe.value().size(), probe.plan().size() + 1);
+    std::printf(
+        "  measured %7.0f us/cycle (%5.1f Hz)   wire limit %7.0f us (%5.1f Hz, %zu bytes)   = %.2fx (target >= 0.97)\n",
+        us, 1e6 / us, limit_us, 1e6 / limit_us, wire_bytes, limit_us / us);
+  }
+  return 0;
+}
