@@ -6,6 +6,7 @@
 //  - heap allocations per exchange in steady state (target 0).
 // SPDX-License-Identifier: BSL-1.0
 #include "alloc_count.hpp"
+#include "served_board.hpp"
 
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
@@ -63,22 +64,6 @@ double echo_floor(std::size_t bytes, int n) {
   return us;
 }
 
-struct served {
-  explicit served(t::serve_options so = {}, board::options bo = {}) : board(bo) {
-    server = t::board_server::serve_pty(io.context(), board, so);
-  }
-  ~served() {
-    std::promise<void> p;
-    boost::asio::post(io.context(), [&] {
-      server->stop();
-      p.set_value();
-    });
-    p.get_future().wait();
-  }
-  board::virtual_board board;
-  t::io_thread io;
-  std::shared_ptr<t::board_server> server;
-};
 }  // namespace
 
 int main() {
@@ -89,7 +74,7 @@ int main() {
   const command cmds[] = {ping{}, move::read_ram(0x0090, 2).value(), const_servo::make(all36, 10).value()};
   const char* names[] = {"ping", "MOV read 2 bytes", "CONST36"};
   {
-    served b;
+    rcb4::testing::served_board b;
     t::io_thread io;
     auto c = t::make_client(t::open_serial(io.context(), b.server->where(), 1250000));
     for (std::size_t k = 0; k < 3; ++k) {
@@ -130,7 +115,7 @@ int main() {
     so.pace = true;
     board::options bo;
     bo.servo_count = 35;
-    served b(so, bo);
+    rcb4::testing::served_board b(so, bo);
     t::io_thread io;
     t::client_options co;
     co.baud = 1250000;

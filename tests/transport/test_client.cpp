@@ -1,6 +1,8 @@
 // The client against the virtual board on a real pseudo-terminal: every API form, deadlines,
 // faults on the line, many threads.
 // SPDX-License-Identifier: BSL-1.0
+#include "served_board.hpp"
+
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/detect.hpp>
@@ -22,6 +24,7 @@
 using namespace rcb4;
 using namespace std::chrono_literals;
 namespace t = rcb4::transport;
+using rcb4::testing::served_board;
 
 // Positive and negative concept checks.
 static_assert(t::AsyncByteStream<boost::asio::serial_port>);
@@ -39,24 +42,6 @@ struct read_only {
 static_assert(!t::AsyncByteStream<read_only>);
 
 namespace {
-/** A virtual board served on a pty by its own thread. */
-struct served_board {
-  explicit served_board(t::serve_options so = {}, board::options bo = {}) : board(bo) {
-    server = t::board_server::serve_pty(server_io.context(), board, std::move(so));
-  }
-  ~served_board() {
-    std::promise<void> done;
-    boost::asio::post(server_io.context(), [&] {
-      server->stop();
-      done.set_value();
-    });
-    done.get_future().wait();
-  }
-  board::virtual_board board;
-  t::io_thread server_io;
-  std::shared_ptr<t::board_server> server;
-};
-
 auto open_client(t::io_thread& io, const std::string& path, t::client_options opt = {}) {
   return t::make_client(t::open_serial(io.context(), path, 1250000), std::move(opt));
 }

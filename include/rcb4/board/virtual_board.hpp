@@ -375,27 +375,21 @@ class virtual_board {
     const std::size_t n = l.src().size();
     if (!read_destination(l.dst(), std::span(a).first(n)) || !read_source(l.src(), std::span(b).first(n)))
       return nack();
-    bool zero = true;
     for (std::size_t i = 0; i < n; ++i) {
       switch (l.op()) {
         case logic_op::and_: a[i] = static_cast<std::uint8_t>(a[i] & b[i]); break;
         case logic_op::or_: a[i] = static_cast<std::uint8_t>(a[i] | b[i]); break;
         case logic_op::xor_: a[i] = static_cast<std::uint8_t>(a[i] ^ b[i]); break;
       }
-      zero = zero && a[i] == 0;
     }
-    return finish_alu(l.dst(), l.mode(), std::span(a).first(n), zero, std::nullopt);
+    return finish_alu(l.dst(), l.mode(), std::span(a).first(n), std::nullopt);
   }
   outcome run(const bit_not& x, origin) {
     std::array<std::uint8_t, max_request_size> a{};
     const std::size_t n = x.size().value();
     if (!read_destination(x.dst(), std::span(a).first(n))) return nack();
-    bool zero = true;
-    for (std::size_t i = 0; i < n; ++i) {
-      a[i] = static_cast<std::uint8_t>(~a[i]);
-      zero = zero && a[i] == 0;
-    }
-    return finish_alu(x.dst(), x.mode(), std::span(a).first(n), zero, std::nullopt);
+    for (std::size_t i = 0; i < n; ++i) a[i] = static_cast<std::uint8_t>(~a[i]);
+    return finish_alu(x.dst(), x.mode(), std::span(a).first(n), std::nullopt);
   }
   outcome run(const shift& x, origin) {
     // The operand is a little-endian integer of `size` bytes; C = the last bit shifted out (model).
@@ -415,9 +409,7 @@ class virtual_board {
           a[i] = static_cast<std::uint8_t>((a[i] >> 1) | (i + 1 < n ? ((a[i + 1] & 1u) << 7) : 0));
       }
     }
-    bool zero = true;
-    for (std::size_t i = 0; i < n; ++i) zero = zero && a[i] == 0;
-    return finish_alu(x.dst(), x.mode(), std::span(a).first(n), zero, count != 0 ? std::optional(carry) : std::nullopt);
+    return finish_alu(x.dst(), x.mode(), std::span(a).first(n), count != 0 ? std::optional(carry) : std::nullopt);
   }
   outcome run(const arith& x, origin) {
     if (x.dst().kind() == dst_kind::com && !opt_.allow_arith_to_com) return nack();
@@ -450,10 +442,12 @@ class virtual_board {
     }
     v &= mask;
     const std::array<std::uint8_t, 2> res = {static_cast<std::uint8_t>(v & 0xFFu), static_cast<std::uint8_t>(v >> 8)};
-    return finish_alu(x.dst(), x.mode(), std::span(res).first(n), v == 0, carry);
+    return finish_alu(x.dst(), x.mode(), std::span(res).first(n), carry);
   }
-  outcome finish_alu(const destination& d, store_mode mode, std::span<const std::uint8_t> result, bool zero,
+  /** Stores (unless flags-only) and sets Z (result all zero) and, when given, C. */
+  outcome finish_alu(const destination& d, store_mode mode, std::span<const std::uint8_t> result,
                      std::optional<bool> carry) {
+    const bool zero = std::all_of(result.begin(), result.end(), [](std::uint8_t b) { return b == 0; });
     if (mode == store_mode::store && !write_destination(d, result)) return nack();
     set_flag_bits(zero, carry);
     return with_data(result);
