@@ -70,10 +70,10 @@ enum class direction : std::uint8_t { tx, rx };
 
 /** Client behaviour. */
 struct client_options {
-  std::uint32_t baud = 115200;               ///< line rate used for deadlines (the slowest is the safe default)
-  std::chrono::milliseconds turnaround{50};  ///< allowance for adapter latency and the board's answer
-  std::chrono::milliseconds quiet{5};        ///< silence that ends a drain after an error
-  unsigned read_retries = 2;                 ///< extra attempts for idempotent reads (ping, VERSION, MOV → COM)
+  std::uint32_t baud = 115200;                ///< line rate used for deadlines (the slowest is the safe default)
+  std::chrono::milliseconds turnaround{100};  ///< allowance for adapter latency, the board's reply, a busy host
+  std::chrono::milliseconds quiet{5};         ///< silence that ends a drain after an error
+  unsigned read_retries = 2;                  ///< extra attempts for idempotent reads (ping, VERSION, MOV → COM)
   bool retry_writes = false;  ///< also retry commands that change the board (only if you know they are safe)
   /** Called with every frame on the line (direction, monotonic time, bytes). */
   std::function<void(direction, std::chrono::steady_clock::time_point, std::span<const std::uint8_t>)> trace;
@@ -242,10 +242,14 @@ class basic_client {
       ++counters_.exchanges;
       if (ec) ++counters_.errors;
       const bool more = !queue_.empty() && !closing_;
-      if (!more) finish_worker();
-      // Completing the handler is the last touch of `this`: its caller may destroy the client.
+      // The completion runs on the strand only after this coroutine suspends or returns, so the
+      // caller cannot see it before finish_worker(); finish_worker() is the last touch of `this`
+      // (a destructor may be waiting for it).
       complete(std::move(p.handler), ec, r);
-      if (!more) co_return;
+      if (!more) {
+        finish_worker();
+        co_return;
+      }
     }
   }
 
