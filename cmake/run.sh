@@ -24,6 +24,7 @@ case "${1:-}" in
   test)
     build_and_test dev            # GCC 12, warnings as errors: unit, static, compile-fail, fuzz replay, Cortex-M4
     build_and_test asan-ubsan     # clang 16 with ASan + UBSan, and each libFuzzer harness for a short run
+    build_and_test tsan           # clang 16 with ThreadSanitizer: the transport tests (threads, client, server)
     build_and_test no-exceptions  # the codec with -fno-exceptions -fno-rtti
     echo "==> all test configurations passed"
     ;;

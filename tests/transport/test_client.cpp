@@ -243,7 +243,7 @@ TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[
   std::filesystem::remove_all(dir);
 }
 
-TEST_CASE("client: operations run on the client; baud detection; bad addresses", "[transport]") {
+TEST_CASE("client: operations run on the client, baud detection, bad addresses", "[transport]") {
   served_board b;
   t::io_thread io;
   std::error_code ec;

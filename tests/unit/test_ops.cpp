@@ -163,7 +163,7 @@ TEST_CASE("ops: play a motion, follow its state, stop one", "[ops][motion]") {
   CHECK(nope.error() == errc::motion_out_of_range);
 }
 
-TEST_CASE("ops: sensors, PIO and receiver; degrees", "[ops][sensors]") {
+TEST_CASE("ops: sensors, PIO, receiver and degrees", "[ops][sensors]") {
   board_wire w;
   w.board().set_battery_volts(11.1);
   w.board().set_receiver(static_cast<std::uint16_t>(krr_button::up), {1, 2, 3, 4});

@@ -178,7 +178,7 @@ TEST_CASE("board: JUMP, CALL and RETURN with conditions and a 16-deep stack", "[
   CHECK_FALSE(config_word::decode(v.read_word(0)).rom_program);
 }
 
-TEST_CASE("board: SINGLE and CONST interpolate over frames; FREE and HOLD", "[board][servo]") {
+TEST_CASE("board: SINGLE and CONST interpolate over frames, FREE and HOLD", "[board][servo]") {
   board_wire w;
   const std::uint16_t ics2_pos = 0x0090 + 40 + 4, ics2_out = 0x0090 + 40 + 6;
   CHECK(w.send(single_servo{2, 8500, 10}).is_ack());
@@ -202,7 +202,7 @@ TEST_CASE("board: SINGLE and CONST interpolate over frames; FREE and HOLD", "[bo
   CHECK(w.read_word(0x0090 + 20 + 4) == 9000);
 }
 
-TEST_CASE("board: SERIES reboots by default, as measured in 2015; executes when asked", "[board][servo]") {
+TEST_CASE("board: SERIES reboots by default (as measured in 2015) and executes when asked", "[board][servo]") {
   board_wire w;
   REQUIRE(w.write_ram(0x0400, {0x12}).is_ack());
   const auto series = series_servo::make(series_opt_in, {{0, {8000, 0}}, {1, {6000, 0}}}).value();
