@@ -1,4 +1,5 @@
-// The failure matrix: for every n, the n-th read or write on the line fails. Each exchange must
+// The failure matrix: for every n, the n-th read or write on the line fails (connection reset, or
+// end of file as when a cable is pulled). Each exchange must
 // end (no hang), never deliver wrong data, and the exchanges after the failure must succeed.
 // SPDX-License-Identifier: BSL-1.0
 #include "fake_stream.hpp"
@@ -32,34 +33,38 @@ TEST_CASE("client: fail the n-th read or write, for every n", "[transport][matri
     total_ops = c.stream().operations();
   }
   REQUIRE(total_ops >= 2 * script.size());
-  for (std::size_t n = 1; n <= total_ops; ++n) {
-    INFO("operation " << n << " of " << total_ops << " fails");
-    board::virtual_board b;
-    t::io_thread io;
-    t::client_options opt;
-    opt.turnaround = 50ms;
-    opt.quiet = 2ms;
-    t::basic_client<rcb4::testing::fake_stream> c(rcb4::testing::fake_stream(io.context().get_executor(), b, n), opt);
-    int failures = 0;
-    for (const auto& cmd : script) {
-      std::error_code ec;
-      const auto r = c.execute(cmd, ec);  // every call returns: a hang would stop the test here
-      if (ec) {
-        ++failures;
-        continue;
+  const boost::system::error_code failures_to_inject[] = {boost::asio::error::connection_reset,
+                                                          boost::asio::error::eof};
+  for (const auto failure : failures_to_inject)
+    for (std::size_t n = 1; n <= total_ops; ++n) {
+      INFO("operation " << n << " of " << total_ops << " fails with " << failure.message());
+      board::virtual_board b;
+      t::io_thread io;
+      t::client_options opt;
+      opt.turnaround = 50ms;
+      opt.quiet = 2ms;
+      t::basic_client<rcb4::testing::fake_stream> c(
+          rcb4::testing::fake_stream(io.context().get_executor(), b, n, failure), opt);
+      int failures = 0;
+      for (const auto& cmd : script) {
+        std::error_code ec;
+        const auto r = c.execute(cmd, ec);  // every call returns: a hang would stop the test here
+        if (ec) {
+          ++failures;
+          continue;
+        }
+        // Whatever succeeds carries the right answer: exactly what the board holds (the write
+        // before it may or may not have reached the board, depending on which operation failed).
+        if (const auto* m = std::get_if<move>(&cmd);
+            m && m->src().kind() == src_kind::ram && m->src().address() == 0x0400) {
+          const auto held = b.ram16(0x0400);  // the exchange is over: the io thread is idle
+          CHECK(r.u16() == held);
+          CHECK((held == 0x3412 || held == 0));
+        }
+        if (std::holds_alternative<version>(cmd)) CHECK(r.data.size() == 32);
       }
-      // Whatever succeeds carries the right answer: exactly what the board holds (the write
-      // before it may or may not have reached the board, depending on which operation failed).
-      if (const auto* m = std::get_if<move>(&cmd);
-          m && m->src().kind() == src_kind::ram && m->src().address() == 0x0400) {
-        const auto held = b.ram16(0x0400);  // the exchange is over: the io thread is idle
-        CHECK(r.u16() == held);
-        CHECK((held == 0x3412 || held == 0));
-      }
-      if (std::holds_alternative<version>(cmd)) CHECK(r.data.size() == 32);
+      CHECK(failures <= 1);  // one broken operation costs at most the exchange it belonged to
+      // And the line is usable afterwards.
+      CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
     }
-    CHECK(failures <= 1);  // one broken operation costs at most the exchange it belonged to
-    // And the line is usable afterwards.
-    CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
-  }
 }
