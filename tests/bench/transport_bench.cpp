@@ -6,6 +6,7 @@
 //  - heap allocations per exchange in steady state (target 0).
 // SPDX-License-Identifier: BSL-1.0
 #include "alloc_count.hpp"
+#include "pty_echo.hpp"
 #include "served_board.hpp"
 
 #include <rcb4/transport/board_server.hpp>
@@ -24,46 +25,13 @@ double us_since(clock_type::time_point start, int n) {
   return std::chrono::duration<double, std::micro>(clock_type::now() - start).count() / n;
 }
 
-/** Round trips of a raw echo on a pty: the floor for any pty server. */
+/** Round trips of a raw echo on a pty of @p bytes each: the floor for any pty server. */
 double echo_floor(std::size_t bytes, int n) {
-  boost::asio::io_context io;
-  t::pty_pair pty;
-  boost::asio::posix::stream_descriptor master(io, pty.release_master());
-  std::array<std::uint8_t, 512> buf{};
-  std::function<void()> loop = [&] {
-    master.async_read_some(boost::asio::buffer(buf), [&](boost::system::error_code ec, std::size_t got) {
-      if (ec) return;
-      boost::asio::async_write(master, boost::asio::buffer(buf.data(), got),
-                               [&](boost::system::error_code e, std::size_t) {
-                                 if (!e) loop();
-                               });
-    });
-  };
-  loop();
-  std::thread th([&] { io.run(); });
-  const int fd = ::open(pty.path().c_str(), O_RDWR | O_NOCTTY);
-  termios tio{};
-  ::tcgetattr(fd, &tio);
-  ::cfmakeraw(&tio);
-  ::tcsetattr(fd, TCSANOW, &tio);
-  std::vector<std::uint8_t> req(bytes, 0x55), rep(bytes);
-  const auto start = clock_type::now();
-  for (int i = 0; i < n; ++i) {
-    if (::write(fd, req.data(), req.size()) < 0) break;
-    std::size_t got = 0;
-    while (got < bytes) {
-      const auto r = ::read(fd, rep.data() + got, bytes - got);
-      if (r <= 0) break;
-      got += static_cast<std::size_t>(r);
-    }
-  }
-  const double us = us_since(start, n);
-  ::close(fd);
-  boost::asio::post(io, [&] { master.close(); });
-  th.join();
-  return us;
+  t::io_thread io;
+  rcb4::testing::pty_echo echo(io.context());
+  const std::vector<std::uint8_t> req(bytes, 0x55);
+  return rcb4::testing::pty_round_trips(echo.path(), req, bytes, n);
 }
-
 }  // namespace
 
 int main() {

@@ -213,7 +213,7 @@ class virtual_board {
   }
   /** The RAM block address of ICS @p n, or nothing when unallocated. */
   std::optional<std::uint16_t> block_of(ics_number n) const noexcept {
-    const std::uint16_t a = ram16(ram::ics_allocation.value() + 2u * n.value());
+    const std::uint16_t a = allocation(n);
     if (a == ram::no_allocation || std::uint32_t{a} + servo_block::size > ram_size) return std::nullopt;
     return a;
   }
@@ -291,8 +291,10 @@ class virtual_board {
 
   // --- memory access through RAM, ICS slots and ROM -------------------------------------------
   /** Where @p size bytes of an ICS field live in RAM, or nothing (unallocated / out of RAM). */
+  /** ICS @p n's allocation-table entry (0xFFFF: unallocated). */
+  std::uint16_t allocation(ics_number n) const noexcept { return ram16(ram::allocation_entry(n).value()); }
   std::optional<std::uint32_t> ics_address(ics_number n, std::uint32_t offset, std::size_t size) const noexcept {
-    const std::uint16_t a = ram16(ram::ics_allocation.value() + 2u * n.value());
+    const std::uint16_t a = allocation(n);
     if (a == ram::no_allocation || a + offset + size > ram_size) return std::nullopt;
     return a + offset;
   }

@@ -23,6 +23,13 @@ namespace detail {
 inline std::uint32_t memory_end(memory m) noexcept {
   return m == memory::ram ? ram_size : m == memory::rom ? rom_size : 256u;
 }
+/** errc{} when @p size (> 0) bytes at @p address fit memory @p m, else the memory's range error. */
+inline errc check_range(memory m, std::uint32_t address, std::size_t size) noexcept {
+  if (size > 0 && address + size <= memory_end(m)) return errc{};
+  return m == memory::ram   ? errc::ram_address_out_of_range
+         : m == memory::rom ? errc::rom_address_out_of_range
+                            : errc::ics_offset_out_of_range;
+}
 inline result<move> read_piece(memory m, ics_number ics, std::uint32_t at, std::size_t n) {
   auto size = transfer_size::make(n);
   if (!size) return size.error();
@@ -67,7 +74,7 @@ class read_memory {
   /** The read; errors (range) show in error() before anything is sent. */
   read_memory(memory m, std::uint32_t address, std::size_t size, ics_number ics = {})
       : mem_(m), ics_(ics), start_(address), size_(size) {
-    if (size == 0 || address + size > detail::memory_end(m)) error_ = range_error();
+    error_ = detail::check_range(m, address, size);
     data_.reserve(size);
   }
   /** The next MOV → COM, or nothing when done or failed. */
@@ -99,11 +106,6 @@ class read_memory {
   const std::vector<std::uint8_t>& value() const noexcept { return data_; }
 
  private:
-  errc range_error() const noexcept {
-    return mem_ == memory::ram   ? errc::ram_address_out_of_range
-           : mem_ == memory::rom ? errc::rom_address_out_of_range
-                                 : errc::ics_offset_out_of_range;
-  }
   /** Address and length of the next read, never 1 byte when 2 are possible. */
   std::pair<std::uint32_t, std::size_t> piece() const noexcept {
     const std::uint32_t at = start_ + static_cast<std::uint32_t>(data_.size());
@@ -129,10 +131,7 @@ class write_memory {
   /** The write; the bytes are copied. */
   write_memory(memory m, std::uint32_t address, std::span<const std::uint8_t> bytes, ics_number ics = {})
       : mem_(m), ics_(ics), start_(address), bytes_(bytes.begin(), bytes.end()) {
-    if (bytes.empty() || address + bytes.size() > detail::memory_end(m))
-      error_ = m == memory::ram   ? errc::ram_address_out_of_range
-               : m == memory::rom ? errc::rom_address_out_of_range
-                                  : errc::ics_offset_out_of_range;
+    error_ = detail::check_range(m, address, bytes.size());
   }
   /** The next MOV literal, or nothing when done or failed. */
   std::optional<command> next() {

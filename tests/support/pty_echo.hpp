@@ -1,0 +1,80 @@
+// The raw pty floor for benchmarks: an Asio echo on a pty master, and a blocking client loop
+// that measures round trips on any pty path (the echo's or a server's).
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <rcb4/transport/pty.hpp>
+
+#include <boost/asio.hpp>
+
+#include <chrono>
+#include <future>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace rcb4::testing {
+
+/** Opens @p path raw and measures @p n round trips of @p request; µs per round trip. */
+inline double pty_round_trips(const std::string& path, std::span<const std::uint8_t> request, std::size_t reply_size,
+                              int n) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
+  termios t{};
+  ::tcgetattr(fd, &t);
+  ::cfmakeraw(&t);
+  ::tcsetattr(fd, TCSANOW, &t);
+  std::vector<std::uint8_t> buf(reply_size);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < n; ++i) {
+    if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size())) break;
+    std::size_t got = 0;
+    while (got < reply_size) {
+      const auto r = ::read(fd, buf.data() + got, reply_size - got);
+      if (r <= 0) break;
+      got += static_cast<std::size_t>(r);
+    }
+  }
+  const auto us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  ::close(fd);
+  return us / n;
+}
+
+/** Echoes every byte back on a new pty, on @p io (run by another thread): the floor any pty server can reach. */
+class pty_echo {
+ public:
+  explicit pty_echo(boost::asio::io_context& io) : stream_(io, pty_.release_master()) {
+    boost::asio::co_spawn(io, echo(), boost::asio::detached);
+  }
+  pty_echo(const pty_echo&) = delete;
+  pty_echo& operator=(const pty_echo&) = delete;
+  /** Closes the echo on its io thread and waits for that. */
+  ~pty_echo() {
+    std::promise<void> done;
+    boost::asio::post(stream_.get_executor(), [&] {
+      boost::system::error_code ignored;
+      stream_.close(ignored);
+      done.set_value();
+    });
+    done.get_future().wait();
+  }
+  /** The pty path to open. */
+  const std::string& path() const noexcept { return pty_.path(); }
+
+ private:
+  boost::asio::awaitable<void> echo() {
+    std::array<std::uint8_t, 512> buf{};
+    for (;;) {
+      boost::system::error_code ec;
+      const auto n = co_await stream_.async_read_some(boost::asio::buffer(buf),
+                                                      boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (ec) co_return;
+      co_await boost::asio::async_write(stream_, boost::asio::buffer(buf.data(), n),
+                                        boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+      if (ec) co_return;
+    }
+  }
+  transport::pty_pair pty_;
+  boost::asio::posix::stream_descriptor stream_;
+};
+
+}  // namespace rcb4::testing
