@@ -49,7 +49,14 @@ enum class errc : std::uint8_t {
   bad_ack_code,      ///< 4-byte reply whose status byte is neither 06 (ACK) nor 15 (NACK)
   unexpected_ack,    ///< ACK where a data reply was expected
   nack,              ///< the board answered NACK (mapped by the transport where an ACK was due)
+  // operations (rcb4/ops.hpp)
+  baud_change_not_allowed,  ///< a config write that changes the COM baud (use ops::switch_baud)
+  unsupported_baud,         ///< a COM rate other than 115200, 625000 or 1250000 (protocol.md §9)
+  index_out_of_range,       ///< counter, user parameter, timer or AD index past the board's count
 };
+
+/** The last errc value (for tables and tests that walk every code). */
+inline constexpr errc errc_last = errc::index_out_of_range;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -87,6 +94,10 @@ constexpr const char* message(errc e) noexcept {
     case errc::bad_ack_code: return "reply status byte neither ACK (06) nor NACK (15)";
     case errc::unexpected_ack: return "ACK received where data was expected";
     case errc::nack: return "board answered NACK";
+    case errc::baud_change_not_allowed:
+      return "config write would change the COM baud; use switch_baud so the host follows";
+    case errc::unsupported_baud: return "COM baud must be 115200, 625000 or 1250000";
+    case errc::index_out_of_range: return "counter, parameter or timer index out of range";
   }
   return "unknown rcb4 error";
 }

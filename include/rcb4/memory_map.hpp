@@ -67,13 +67,13 @@ constexpr std::uint32_t bits_per_second(baud_code b) noexcept {
     default: return 115200;
   }
 }
-/** The code of @p bps: 115200, 625000 or 1250000; other rates are errc::reserved_bits_set. */
+/** The code of @p bps: 115200, 625000 or 1250000; other rates are errc::unsupported_baud. */
 constexpr result<baud_code> baud_code_of(std::uint32_t bps) noexcept {
   switch (bps) {
     case 115200: return baud_code::b115200;
     case 625000: return baud_code::b625000;
     case 1250000: return baud_code::b1250000;
-    default: return errc::reserved_bits_set;
+    default: return errc::unsupported_baud;
   }
 }
 

@@ -91,7 +91,7 @@ static_assert(checksum(old_ping) == 0x08);
 
 // Error messages exist for every value.
 constexpr bool every_error_has_message() {
-  for (int e = 1; e <= static_cast<int>(errc::nack); ++e)
+  for (int e = 1; e <= static_cast<int>(errc_last); ++e)
     if (std::string_view(message(static_cast<errc>(e))) == "unknown rcb4 error") return false;
   return true;
 }

@@ -144,6 +144,46 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
     mode = 0;
     CHECK(c.execute(read).u16() == 0x03FF);  // the next exchange starts on a clean line
   }
+  // Split and late replies (pieces written with delays, as a slow adapter or a busy board would).
+  t::serve_options so2;
+  std::atomic<int> timing{0};
+  so2.pieces = [&timing](std::size_t size) -> std::vector<t::reply_piece> {
+    switch (timing.load()) {
+      case 1: return {{0us, 1}, {3ms, 2}, {3ms, size}};                          // split in three, in time
+      case 2: return std::vector<t::reply_piece>(size, t::reply_piece{1ms, 1});  // byte by byte
+      case 3: return {{60ms, size}};                                             // after the deadline
+      case 4: return {{0us, size / 2}, {60ms, size}};                            // half, then late
+      default: return {};
+    }
+  };
+  served_board late(so2);
+  auto c2 = open_client(io, late.server->where(), opt);
+  const auto config = move::read_ram(ram::config, 2).value();
+  for (int m : {1, 2}) {
+    INFO("timing mode " << m);
+    timing = m;
+    CHECK(c2.execute(read).u16() == 0x03FF);  // a reply in pieces is still one reply
+  }
+  for (int m : {3, 4}) {
+    INFO("timing mode " << m);
+    timing = m;
+    std::error_code ec;
+    c2.execute(read, ec);
+    CHECK(ec == t::errc::timeout);
+    timing = 0;
+    // The late PIO reply has the same shape as the config reply: it must never be taken for it.
+    // (The exchange right after may itself time out while the line resynchronises.)
+    bool answered = false;
+    for (int k = 0; k < 5 && !answered; ++k) {
+      const auto r = c2.execute(config, ec);
+      if (!ec) {
+        CHECK(r.u16() == board::default_config);
+        answered = true;
+      }
+    }
+    CHECK(answered);
+  }
+
   // A duplicated reply: the copy left on the line is drained, not taken as the next reply.
   mode = 4;
   CHECK(c.execute(ping{}).kind == reply_kind::ack);

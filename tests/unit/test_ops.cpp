@@ -185,3 +185,186 @@ TEST_CASE("ops: sensors, PIO, receiver and degrees", "[ops][sensors]") {
   CHECK(ops::from_degrees(300).error() == errc::position_out_of_range);
   CHECK(std::isnan(ops::to_degrees(servo_position::free())));
 }
+
+TEST_CASE("ops: version, typed config read and write, baud switch", "[ops][system]") {
+  board_wire w;
+  ops::read_version v;
+  run(w, v);
+  REQUIRE(v.error() == errc{});
+  CHECK(v.value() == "CB-4 V1.0      090715");
+  CHECK(v.raw()[31] == 0xC7);
+  ops::read_config rc;
+  run(w, rc);
+  REQUIRE(rc.error() == errc{});
+  CHECK(rc.value().encode() == 0x008B);  // the board's boot word
+  CHECK(rc.value().com_baud == baud_code::b1250000);
+
+  // Change the output period and the LED; the other bits stay as the board had them.
+  auto wc = ops::update_config([](config_word& c) {
+    c.period = output_period::ms20;
+    c.led = true;
+  });
+  CHECK(run(w, wc).size() == 2);
+  REQUIRE(wc.error() == errc{});
+  CHECK(w.read_word(0x0000) == (0x008B | 0x0020 | 0x8000));
+
+  // A write that would lose the host is refused before anything is written.
+  config_word slow = config_word::decode(0x000B);  // 115200
+  auto refused = ops::write_config(slow);
+  CHECK(run(w, refused).size() == 1);  // only the read
+  CHECK(refused.error() == errc::baud_change_not_allowed);
+  CHECK(w.read_word(0x0000) == (0x008B | 0x0020 | 0x8000));
+
+  auto bad = ops::switch_baud(9600);
+  CHECK(run(w, bad).empty());
+  CHECK(bad.error() == errc::unsupported_baud);
+
+  auto sw = ops::switch_baud(625000);
+  run(w, sw);
+  REQUIRE(sw.error() == errc{});
+  CHECK(w.board().line_baud() == 625000);
+  CHECK(sw.value().com_baud == baud_code::b625000);
+  CHECK(sw.before().com_baud == baud_code::b1250000);
+}
+
+TEST_CASE("ops: scan, free and hold, parameters, per-servo speeds", "[ops][servo]") {
+  board_wire w;
+  ops::scan_servos scan;
+  run(w, scan);
+  REQUIRE(scan.error() == errc{});
+  REQUIRE(scan.value().size() == 22);
+  CHECK(scan.value().front() == ops::servo_slot{ics_number{0}, 0x0090});
+  CHECK(scan.value().back() == ops::servo_slot{ics_number{21}, 0x0090 + 21 * 20});
+
+  auto all_free = ops::set_servo_power(ops::power_state::free);
+  CHECK(run(w, all_free).size() == 2);  // the table, then one CONST frame
+  REQUIRE(all_free.error() == errc{});
+  CHECK(all_free.value().size() == 22);
+  w.wait(30ms);
+  for (unsigned k = 0; k < 22; ++k) CHECK(w.read_word(static_cast<std::uint16_t>(0x0090 + 20 * k + 6)) == 0x8000);
+
+  servo_mask three;
+  three.insert(ics_number{3});
+  auto hold = ops::set_servo_power(ops::power_state::hold, three);
+  CHECK(run(w, hold).size() == 1);  // no table read for an explicit set
+  w.wait(30ms);
+  CHECK(w.read_word(0x0090 + 60 + 6) == 0x7FFF);
+  CHECK(w.read_word(0x0090 + 80 + 6) == 0x8000);
+
+  servo_mask two;
+  two.insert(ics_number{1});
+  two.insert(ics_number{2});
+  auto stretch = ops::set_servo_param(param_kind::stretch, servo_param{30}, two);
+  run(w, stretch);
+  REQUIRE(stretch.error() == errc{});
+  CHECK(w.board().servo_params_of(ics_number{1}).second == 30);
+  CHECK(w.board().servo_params_of(ics_number{2}).second == 30);
+  CHECK(w.board().servo_params_of(ics_number{3}).second == 127);
+  auto speed_all = ops::set_servo_param(param_kind::speed, servo_param{64});
+  run(w, speed_all);
+  CHECK(w.board().servo_params_of(ics_number{21}).first == 64);
+
+  servo_set<timed_position> moves;
+  moves.insert(ics_number{0}, {servo_position{8000}, frames{10}});
+  moves.insert(ics_number{1}, {servo_position{7000}, frames{30}});
+  moves.insert(ics_number{2}, {servo_position{9000}, frames{10}});
+  auto mv = ops::move_servos(moves);
+  const auto sent = run(w, mv);
+  REQUIRE(mv.error() == errc{});
+  REQUIRE(sent.size() == 2);
+  CHECK(std::get<const_servo>(sent[0]).speed() == frames{30});  // slowest first
+  CHECK(std::get<const_servo>(sent[0]).targets().size() == 1);
+  CHECK(std::get<const_servo>(sent[1]).targets().size() == 2);
+  w.wait(1s);
+  CHECK(w.read_word(0x0090 + 0 + 4) == 8000);
+  CHECK(w.read_word(0x0090 + 20 + 4) == 7000);
+  CHECK(w.read_word(0x0090 + 40 + 4) == 9000);
+
+  auto none = ops::set_servo_power(ops::power_state::free, servo_mask{});
+  CHECK(run(w, none).empty());
+  CHECK(none.error() == errc::empty_servo_set);
+}
+
+TEST_CASE("ops: counters, user parameters, timers, PIO writes, receiver emulation", "[ops][io]") {
+  board_wire w;
+  auto c = ops::write_counter(10, 200);
+  run(w, c);
+  REQUIRE(c.error() == errc{});
+  auto p = ops::write_user_param(19, -1234);
+  run(w, p);
+  REQUIRE(p.error() == errc{});
+  ops::read_counters rc;
+  run(w, rc);
+  CHECK(rc.value()[10] == 200);
+  CHECK(w.read_ram(0x0457 + 10, 2)[0] == 200);
+  ops::read_user_params rp;
+  run(w, rp);
+  CHECK(rp.value()[19] == -1234);
+  CHECK(w.read_word(0x0462 + 38) == static_cast<std::uint16_t>(-1234));
+
+  auto t = ops::write_timer(2, 20);  // 2 s
+  run(w, t);
+  w.wait(1050ms);
+  ops::read_timers rt;
+  run(w, rt);
+  REQUIRE(rt.error() == errc{});
+  CHECK(rt.value()[2] == 10);
+  CHECK(rt.value()[0] == ram::timer_stopped);
+
+  auto c2 = ops::write_counter(11, 0);
+  CHECK(run(w, c2).empty());
+  CHECK(c2.error() == errc::index_out_of_range);
+  auto p2 = ops::write_user_param(20, 0);
+  CHECK(run(w, p2).empty());
+  CHECK(p2.error() == errc::index_out_of_range);
+  auto t2 = ops::write_timer(4, 0);
+  CHECK(run(w, t2).empty());
+  CHECK(t2.error() == errc::index_out_of_range);
+
+  auto pio = ops::write_pio(0x0003, 0x0001);
+  run(w, pio);
+  REQUIRE(pio.error() == errc{});
+  ops::read_pio rpio;
+  run(w, rpio);
+  CHECK(rpio.value().direction == 0x0003);
+  CHECK((rpio.value().value & 0x0003) == 0x0001);
+  auto bad_pio = ops::write_pio(0x0400, 0);
+  CHECK(run(w, bad_pio).empty());
+  CHECK(bad_pio.error() == errc::reserved_bits_set);
+
+  const auto buttons = static_cast<std::uint16_t>(static_cast<std::uint16_t>(krr_button::up) |
+                                                  static_cast<std::uint16_t>(krr_button::s1));
+  auto emu = ops::emulate_receiver(buttons, {10, 20, 30, 127});
+  run(w, emu);
+  REQUIRE(emu.error() == errc{});
+  ops::read_receiver rr;
+  run(w, rr);
+  CHECK(rr.value().buttons == buttons);
+  CHECK(rr.value().analog == std::array<std::uint8_t, 4>{10, 20, 30, 127});
+  CHECK(ops::emulate_receiver(0x0080).error() == errc::reserved_bits_set);
+  CHECK(ops::emulate_receiver(0, {128, 0, 0, 0}).error() == errc::param_out_of_range);
+}
+
+TEST_CASE("ops: suspend and resume a motion", "[ops][motion]") {
+  board_wire w;
+  ops::play_motion play(2);
+  run(w, play);
+  w.wait(100ms);
+  ops::suspend_motion suspend;
+  run(w, suspend);
+  REQUIRE(suspend.error() == errc{});
+  w.wait(2s);
+  ops::read_motion_state held;
+  run(w, held);
+  CHECK(held.value().motion == 2u);  // still inside motion 2, not going anywhere
+  CHECK(w.read_word(0x0090 + 60 + 4) == 9500);
+  auto resume = ops::resume_motion();
+  run(w, resume);
+  REQUIRE(resume.error() == errc{});
+  CHECK(resume.value().rom_program);
+  w.wait(3s);
+  ops::read_motion_state done;
+  run(w, done);
+  CHECK_FALSE(done.value().running);
+  CHECK(w.read_word(0x0090 + 60 + 4) == 7500);  // the motion finished: the arm is back down
+}

@@ -42,7 +42,7 @@ TEST_CASE("errc is a std::error_code with category rcb4", "[errors]") {
   CHECK(ec.message() == "checksum mismatch");
   CHECK(ec == errc::bad_checksum);
   CHECK(fmt::format("{}", errc::nack) == "board answered NACK");
-  for (int e = 1; e <= static_cast<int>(errc::nack); ++e)
+  for (int e = 1; e <= static_cast<int>(errc_last); ++e)
     CHECK(std::error_code(static_cast<errc>(e)).message() != "unknown rcb4 error");
 }
 

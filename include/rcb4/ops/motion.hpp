@@ -7,6 +7,7 @@
 #pragma once
 
 #include <rcb4/ops/operation.hpp>
+#include <rcb4/ops/system.hpp>
 
 #include <array>
 
@@ -153,5 +154,13 @@ class stop_motion {
   unsigned step_ = 0;
   errc error_{};
 };
+
+/** Suspends the ROM program: the same as stop_motion; resume_motion continues where it was. */
+using suspend_motion = stop_motion;
+
+/** Resumes a suspended ROM program where it stopped (config bits 0, 1 and 3 set). */
+inline auto resume_motion() {
+  return update_config([](config_word& c) { c.ics_enabled = c.rom_program = c.vector_jump = true; });
+}
 
 }  // namespace rcb4::ops

@@ -27,26 +27,6 @@ struct receiver_state {
 };
 
 namespace detail {
-/** A single-read operation decoding @p Size bytes at @p Address with @p Decode. */
-template <class T, std::uint16_t Address, std::uint8_t Size, class Decode>
-class single_read {
- public:
-  std::optional<command> next() {
-    if (done_) return std::nullopt;
-    return command{move::read_ram(ram_address::make(Address).value(), transfer_size::make(Size).value()).value()};
-  }
-  void on_reply(const reply& r) {
-    done_ = true;
-    if ((error_ = check_reply(r, true, Size)) == errc{}) value_ = Decode{}(r);
-  }
-  errc error() const noexcept { return error_; }
-  const T& value() const noexcept { return value_; }
-
- private:
-  bool done_ = false;
-  T value_{};
-  errc error_{};
-};
 struct decode_analog {
   analog_inputs operator()(const reply& r) const {
     analog_inputs a;

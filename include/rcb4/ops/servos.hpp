@@ -2,13 +2,17 @@
 // SPDX-License-Identifier: BSL-1.0
 //
 // Servo blocks are found through the ICS allocation table at RAM 0x0044 (protocol.md §6, §7),
-// not by assuming HTH4's 0x0090 + 20·k. Moving servos needs no operation: send the codec's
-// single_servo / const_servo (FREE and HOLD are servo_position::free() / hold()).
+// not by assuming HTH4's 0x0090 + 20·k. Moving a set of servos at one speed is the codec's
+// const_servo; move_servos adds per-servo speeds without SERIES (one CONST frame per distinct
+// speed). Free/hold and the ICS speed/stretch parameters apply to a given set or to every
+// allocated servo (the operation reads the allocation table first).
 #pragma once
 
 #include <rcb4/ops/memory.hpp>
 #include <rcb4/ops/planner.hpp>
 
+#include <algorithm>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -28,6 +32,52 @@ inline double to_degrees(servo_position p) noexcept {
   return (p.value() - double{servo_position::centre_value}) / counts_per_degree;
 }
 
+/** An allocated ICS slot and its servo data block's RAM address. */
+struct servo_slot {
+  ics_number ics{};           ///< the slot
+  std::uint16_t address = 0;  ///< its 20-byte block
+  friend bool operator==(const servo_slot&, const servo_slot&) = default;
+};
+
+namespace detail {
+/** The allocation table read: ICS 0–34, 2 bytes each at 0x0044 (ICS 35 has no entry, §6). */
+inline command read_allocation() { return command{move::read_ram(ram::ics_allocation, 70).value()}; }
+/** The allocated slots in a reply to read_allocation() (entries pointing past RAM are skipped). */
+inline std::vector<servo_slot> allocated_slots(const reply& r) {
+  std::vector<servo_slot> slots;
+  for (unsigned k = 0; k < 35; ++k) {
+    const std::uint16_t a = r.u16(2 * k);
+    if (a == ram::no_allocation || std::uint32_t{a} + servo_block::size > ram_size) continue;
+    slots.push_back({ics_number::make(k).value(), a});
+  }
+  return slots;
+}
+}  // namespace detail
+
+/** Scans the allocation table: the ICS slots that have a servo block, ascending. */
+class scan_servos {
+ public:
+  /** The table read, once. */
+  std::optional<command> next() {
+    if (done_) return std::nullopt;
+    return detail::read_allocation();
+  }
+  /** Takes its reply. */
+  void on_reply(const reply& r) {
+    done_ = true;
+    if ((error_ = detail::check_reply(r, true, 70)) == errc{}) slots_ = detail::allocated_slots(r);
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return error_; }
+  /** The allocated slots. */
+  const std::vector<servo_slot>& value() const noexcept { return slots_; }
+
+ private:
+  bool done_ = false;
+  std::vector<servo_slot> slots_;
+  errc error_{};
+};
+
 /** One servo's state from its data block. */
 struct servo_state {
   ics_number ics{};            ///< the slot
@@ -45,7 +95,7 @@ class read_servo_states {
   /** The next read. */
   std::optional<command> next() {
     if (error_ != errc{}) return std::nullopt;
-    if (!table_read_) return command{move::read_ram(ram::ics_allocation, 70).value()};  // ICS 0–34
+    if (!table_read_) return detail::read_allocation();
     if (step_ >= plan_.size()) return std::nullopt;
     return command{
         move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
@@ -56,12 +106,8 @@ class read_servo_states {
     if (!table_read_) {
       if ((error_ = detail::check_reply(r, true, 70)) != errc{}) return;
       std::vector<byte_range> wanted;
-      for (unsigned k = 0; k < 35; ++k) {
-        const std::uint16_t a = r.u16(2 * k);
-        if (a == ram::no_allocation || std::uint32_t{a} + servo_block::size > ram_size) continue;
-        blocks_.push_back({ics_number::make(k).value(), a});
-        wanted.push_back({a + 2u, 6u});  // trim, position, target
-      }
+      blocks_ = detail::allocated_slots(r);
+      for (const auto& b : blocks_) wanted.push_back({b.address + 2u, 6u});  // trim, position, target
       plan_ = plan_reads(wanted, cost_);
       memory_.assign(ram_size, 0);
       table_read_ = true;
@@ -79,10 +125,6 @@ class read_servo_states {
   const std::vector<byte_range>& plan() const noexcept { return plan_; }
 
  private:
-  struct block {
-    ics_number ics;
-    std::uint16_t address;
-  };
   std::uint16_t word(std::uint32_t a) const { return static_cast<std::uint16_t>(memory_[a] | (memory_[a + 1] << 8)); }
   void decode() {
     for (const auto& b : blocks_)
@@ -91,12 +133,127 @@ class read_servo_states {
   }
   link_cost cost_;
   bool table_read_ = false;
-  std::vector<block> blocks_;
+  std::vector<servo_slot> blocks_;
   std::vector<byte_range> plan_;
   std::size_t step_ = 0;
   std::vector<std::uint8_t> memory_;
   std::vector<servo_state> states_;
   errc error_{};
 };
+
+namespace detail {
+/**
+ * Sends commands built for a set of servos, each answered by ACK. Without an explicit set it
+ * first reads the allocation table and uses every allocated slot. value(): the slots addressed.
+ */
+template <class Build>
+class on_servos {
+ public:
+  on_servos(std::optional<servo_mask> which, Build build) : build_(std::move(build)) {
+    if (which) use(*which);
+  }
+  std::optional<command> next() {
+    if (error_ != errc{}) return std::nullopt;
+    if (!have_mask_) return read_allocation();
+    if (sent_ >= commands_.size()) return std::nullopt;
+    return commands_[sent_];
+  }
+  void on_reply(const reply& r) {
+    if (!have_mask_) {
+      if ((error_ = check_reply(r, true, 70)) != errc{}) return;
+      servo_mask all;
+      for (const auto& s : allocated_slots(r)) all.insert(s.ics);
+      use(all);
+      return;
+    }
+    if ((error_ = check_reply(r, false)) == errc{}) ++sent_;
+  }
+  errc error() const noexcept { return error_; }
+  servo_mask value() const noexcept { return mask_; }
+
+ private:
+  void use(servo_mask m) {
+    have_mask_ = true;
+    mask_ = m;
+    if (m.empty()) {
+      error_ = errc::empty_servo_set;
+      return;
+    }
+    auto built = build_(m);
+    if (!built)
+      error_ = built.error();
+    else
+      commands_ = std::move(*built);
+  }
+  Build build_;
+  bool have_mask_ = false;
+  servo_mask mask_{};
+  std::vector<command> commands_;
+  std::size_t sent_ = 0;
+  errc error_{};
+};
+template <class Build>
+on_servos(std::optional<servo_mask>, Build) -> on_servos<Build>;
+}  // namespace detail
+
+/** What set_servo_power leaves the servos in. */
+enum class power_state : std::uint8_t {
+  free,  ///< no torque: the servo can be moved by hand (position 0x8000)
+  hold,  ///< torque on at the current position (position 0x7FFF)
+};
+
+/** Frees or holds the servos of @p which, or every allocated servo when it is empty. */
+inline auto set_servo_power(power_state state, std::optional<servo_mask> which = std::nullopt) {
+  return detail::on_servos(which, [state](servo_mask m) -> result<std::vector<command>> {
+    servo_set<servo_position> set;
+    for (auto n : m) set.insert(n, state == power_state::free ? servo_position::free() : servo_position::hold());
+    auto c = const_servo::make(set, frames{1});
+    if (!c) return c.error();
+    return std::vector<command>{command{*c}};
+  });
+}
+
+/**
+ * Sets the ICS speed (output limit) or stretch (softness) parameter to @p value (1–127) on the
+ * servos of @p which, or on every allocated servo (protocol.md §4.9).
+ */
+inline auto set_servo_param(param_kind kind, servo_param value, std::optional<servo_mask> which = std::nullopt) {
+  return detail::on_servos(which, [kind, value](servo_mask m) -> result<std::vector<command>> {
+    servo_set<servo_param> set;
+    for (auto n : m) set.insert(n, value);
+    auto c = servo_params::make(kind, set);
+    if (!c) return c.error();
+    return std::vector<command>{command{*c}};
+  });
+}
+
+/**
+ * Moves servos with a speed (interpolation frames) per servo, without SERIES (§4.8, unverified
+ * on the RCB-4HV): one CONST frame per distinct speed, sent back to back, slowest first so that
+ * the group that finishes last starts first. value(): the servos moved.
+ */
+inline auto move_servos(const servo_set<timed_position>& targets) {
+  std::optional<servo_mask> mask = targets.mask();
+  return detail::on_servos(mask, [targets](servo_mask) -> result<std::vector<command>> {
+    std::vector<command> out;
+    std::array<bool, 256> seen{};
+    std::vector<std::uint8_t> speeds;
+    for (const auto& e : targets) {
+      const auto f = e.value.speed.value();
+      if (!seen[f]) speeds.push_back(f);
+      seen[f] = true;
+    }
+    std::sort(speeds.begin(), speeds.end(), std::greater<>{});
+    for (auto f : speeds) {
+      servo_set<servo_position> group;
+      for (const auto& e : targets)
+        if (e.value.speed.value() == f) group.insert(e.ics, e.value.position);
+      auto c = const_servo::make(group, frames::make(f).value());
+      if (!c) return c.error();
+      out.emplace_back(*c);
+    }
+    return out;
+  });
+}
 
 }  // namespace rcb4::ops

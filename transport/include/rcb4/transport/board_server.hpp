@@ -20,12 +20,23 @@
 
 namespace rcb4::transport {
 
+/** Part of a reply delivered by itself: @p bytes written after waiting @p delay. */
+struct reply_piece {
+  std::chrono::microseconds delay{0};  ///< wait before writing this piece
+  std::size_t bytes = 0;               ///< how many bytes of the reply
+};
+
 /** How the server behaves on the wire. */
 struct serve_options {
   bool pace = false;                     ///< deliver replies at the line's byte rate
   std::chrono::microseconds latency{0};  ///< extra delay before each reply (adapter, turnaround)
   /** Fault injection for testing clients: may change, drop (clear) or extend each reply. */
   std::function<void(std::vector<std::uint8_t>& reply)> tamper;
+  /**
+   * Fault injection for timing: splits each reply into pieces, each written after its delay
+   * (a delayed reply is one piece with a long delay). Bytes past the pieces go out at the end.
+   */
+  std::function<std::vector<reply_piece>(std::size_t reply_size)> pieces;
 };
 
 /** Wire time of @p bytes at @p baud with 8E1 framing (11 bits per byte). */
@@ -116,7 +127,18 @@ class board_server : public std::enable_shared_from_this<board_server> {
         pacer.expires_after(delay);
         co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
       }
-      co_await boost::asio::async_write(stream, boost::asio::buffer(out),
+      std::size_t sent = 0;
+      if (opt_.pieces)
+        for (const auto& p : opt_.pieces(out.size())) {
+          const std::size_t k = std::min(p.bytes, out.size() - sent);
+          pacer.expires_after(p.delay);
+          co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+          co_await boost::asio::async_write(stream, boost::asio::buffer(out.data() + sent, k),
+                                            boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+          if (ec) co_return;
+          sent += k;
+        }
+      co_await boost::asio::async_write(stream, boost::asio::buffer(out.data() + sent, out.size() - sent),
                                         boost::asio::redirect_error(boost::asio::use_awaitable, ec));
       if (ec) co_return;
     }

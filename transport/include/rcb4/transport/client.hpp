@@ -35,6 +35,7 @@
 
 #include <sys/ioctl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <deque>
@@ -79,14 +80,45 @@ struct client_options {
   std::function<void(direction, std::chrono::steady_clock::time_point, std::span<const std::uint8_t>)> trace;
 };
 
+/**
+ * How a client reopens a lost link (EOF, EIO, ENODEV: an unplugged adapter, a stopped server).
+ * Attempts are spaced by a delay that starts at first_delay and doubles up to max_delay; after
+ * give_up_after without success the exchange fails with errc::reconnect_failed, and the next
+ * exchange starts trying again.
+ */
+struct reconnect_policy {
+  std::chrono::milliseconds first_delay{50};      ///< wait after the first failed attempt
+  std::chrono::milliseconds max_delay{1000};      ///< the longest wait between attempts
+  std::chrono::milliseconds give_up_after{5000};  ///< total time one exchange spends reconnecting
+};
+
+/** True for errors that mean the link itself is gone (as opposed to a bad or missing reply). */
+inline bool is_link_lost(const std::error_code& ec) noexcept {
+  if (ec == errc::closed) return true;
+  if (ec.category() != std::system_category() && ec.category() != std::generic_category()) return false;
+  switch (ec.value()) {
+    case EIO:
+    case ENODEV:
+    case ENXIO:
+    case EBADF:
+    case EPIPE:
+    case ECONNRESET:
+    case ECONNABORTED:
+    case ENOTCONN:
+    case ESHUTDOWN: return true;
+    default: return false;
+  }
+}
+
 /** What the client has done. */
 struct client_counters {
-  std::atomic<std::uint64_t> exchanges{0};  ///< requests completed (success or not)
-  std::atomic<std::uint64_t> retries{0};    ///< extra attempts
-  std::atomic<std::uint64_t> timeouts{0};   ///< deadlines missed
-  std::atomic<std::uint64_t> errors{0};     ///< exchanges that ended in an error
-  std::atomic<std::uint64_t> bytes_out{0};  ///< bytes written
-  std::atomic<std::uint64_t> bytes_in{0};   ///< bytes read (drained bytes included)
+  std::atomic<std::uint64_t> exchanges{0};   ///< requests completed (success or not)
+  std::atomic<std::uint64_t> retries{0};     ///< extra attempts
+  std::atomic<std::uint64_t> timeouts{0};    ///< deadlines missed
+  std::atomic<std::uint64_t> errors{0};      ///< exchanges that ended in an error
+  std::atomic<std::uint64_t> bytes_out{0};   ///< bytes written
+  std::atomic<std::uint64_t> bytes_in{0};    ///< bytes read (drained bytes included)
+  std::atomic<std::uint64_t> reconnects{0};  ///< links reopened after a loss
 };
 
 /** True for commands that can be repeated without changing the board: ping, VERSION, MOV → COM. */
@@ -180,14 +212,24 @@ class basic_client {
     return r;
   }
 
+  /**
+   * Reopens the link after a loss: @p reopen(stream, ec) replaces the stream (e.g. with
+   * open_serial on the same path) or sets ec. Call before the first exchange. The exchange that
+   * met the loss fails, unless it is a retriable read, which is retried on the new link.
+   */
+  void set_reconnect(std::function<void(Stream&, std::error_code&)> reopen, reconnect_policy policy = {}) {
+    reopen_ = std::move(reopen);
+    policy_ = policy;
+  }
+
   /** The stream (for settings such as the baud rate; do not read or write it directly). */
   Stream& stream() noexcept { return stream_; }
   /** The options; change them only while no exchange runs. */
   client_options& options() noexcept { return opt_; }
   /** What the client has done so far. */
   const client_counters& counters() const noexcept { return counters_; }
-  /** The strand all exchanges run on. */
-  executor_type get_executor() const noexcept { return stream_.get_executor(); }
+  /** The stream's executor (exchanges run on a strand of it). */
+  executor_type get_executor() const noexcept { return strand_.get_inner_executor(); }
 
  private:
   struct request {
@@ -289,20 +331,91 @@ class basic_client {
     return boost::asio::bind_cancellation_slot(cancel_.slot(), boost::asio::as_tuple(boost::asio::use_awaitable));
   }
 
-  /** Reads and discards until the line has been quiet for opt_.quiet. */
+  /**
+   * Brings the line back to a known state after an error. The board answers in order, so a ping
+   * sent now is answered after every byte it still owed (a late reply, the rest of a split one):
+   * everything up to that ACK is discarded, then the line must stay quiet for opt_.quiet. No ACK
+   * within the ping's budget is errc::timeout: the line stays dirty, and the exchange counts it
+   * as a timed-out attempt (a write is then not sent at all).
+   */
   boost::asio::awaitable<std::error_code> drain() {
+    static constexpr std::array<std::uint8_t, 4> ack{0x04, 0xFE, 0x06, 0x08};
+    static const auto ping_frame = encode(ping{});
+    const request sync{ping_frame, expected_reply(ping{}), true};
     std::array<std::uint8_t, 256> junk{};
-    for (;;) {
-      arm(opt_.quiet);
-      auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(junk), token());
+    std::array<std::uint8_t, 4> tail{};  // the last 4 bytes seen, newest last
+    std::size_t seen = 0;
+    unsigned rearmed = 0;
+    {
+      trace(direction::tx, ping_frame.bytes());
+      arm(budget(sync));
+      auto [we, wn] = co_await boost::asio::async_write(
+          stream_, boost::asio::buffer(ping_frame.bytes().data(), ping_frame.size()), token());
+      counters_.bytes_out += wn;
+      if (we && !timed_out_) {
+        disarm();
+        co_return line_error(we);
+      }
+      bool synced = false;
+      while (!timed_out_) {
+        auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(junk), token());
+        if (timed_out_) break;
+        if (e) {
+          disarm();
+          co_return line_error(e);
+        }
+        counters_.bytes_in += n;
+        trace(direction::rx, std::span(junk).first(n));
+        for (std::size_t i = 0; i < n; ++i) {
+          std::rotate(tail.begin(), tail.begin() + 1, tail.end());
+          tail.back() = junk[i];
+          ++seen;
+        }
+        if (seen >= 4 && tail == ack) {  // our ACK, unless more bytes follow it
+          disarm();
+          arm(opt_.quiet);
+          synced = true;
+        } else if (synced) {
+          synced = false;  // more came after an ACK-like tail: keep reading until the real one
+          disarm();
+          if (++rearmed > 8) break;  // a line that never settles
+          arm(budget(sync));
+        }
+      }
       disarm();
-      if (timed_out_) break;  // quiet
-      if (e) co_return e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
-      counters_.bytes_in += n;
-      trace(direction::rx, std::span(junk).first(n));
+      if (synced) {
+        dirty_ = false;
+        co_return std::error_code{};
+      }
     }
-    dirty_ = false;
-    co_return std::error_code{};
+    co_return errc::timeout;
+  }
+
+  /** An I/O error as the client reports it: end of file is errc::closed. */
+  static std::error_code line_error(const boost::system::error_code& e) {
+    return e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
+  }
+
+  /** Reopens the link with backoff until policy_.give_up_after. */
+  boost::asio::awaitable<std::error_code> reconnect() {
+    const auto give_up = std::chrono::steady_clock::now() + policy_.give_up_after;
+    auto delay = policy_.first_delay;
+    for (;;) {
+      if (closing_) co_return errc::cancelled;
+      std::error_code e;
+      reopen_(stream_, e);
+      if (!e) {
+        lost_ = false;
+        dirty_ = false;
+        ++counters_.reconnects;
+        co_return std::error_code{};
+      }
+      const auto now = std::chrono::steady_clock::now();
+      if (now >= give_up) co_return errc::reconnect_failed;
+      timer_.expires_at(std::min(give_up, now + delay));
+      co_await timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable));
+      delay = std::min(policy_.max_delay, delay * 2);
+    }
   }
 
   boost::asio::awaitable<std::error_code> perform(const request& req, response& out) {
@@ -310,11 +423,23 @@ class basic_client {
     std::error_code ec;
     for (unsigned attempt = 0; attempt < attempts; ++attempt) {
       if (attempt > 0) ++counters_.retries;
+      if (lost_ && reopen_) {
+        ec = co_await reconnect();
+        if (ec) co_return ec;
+      }
       if (bytes_waiting() > 0) dirty_ = true;  // stray bytes (a late or duplicated reply)
       if (dirty_) {
         ec = co_await drain();
-        if (ec) co_return ec;
+        if (ec == errc::timeout) {
+          ++counters_.timeouts;
+          continue;
+        }
+        if (ec) {
+          if (is_link_lost(ec)) lost_ = true;
+          co_return ec;
+        }
       }
+      ec.clear();  // this attempt's own outcome
       detail::exchange ex(req.frame.bytes(), req.shape);
       trace(direction::tx, req.frame.bytes());
       arm(budget(req));
@@ -324,20 +449,24 @@ class basic_client {
           auto [e, n] = co_await boost::asio::async_write(stream_, boost::asio::buffer(w.data(), w.size()), token());
           counters_.bytes_out += n;
           ex.wrote(n);
-          if (e && !timed_out_) ec = e;
+          if (e && !timed_out_) ec = line_error(e);
         } else {
           const auto buf = ex.read_buffer();
           auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(buf.data(), buf.size()), token());
           counters_.bytes_in += n;
           trace(direction::rx, buf.first(n));
           if (n > 0) ex.received(n);
-          if (e && !timed_out_) ec = e == boost::asio::error::eof ? std::error_code(errc::closed) : std::error_code(e);
+          if (e && !timed_out_) ec = line_error(e);
         }
       }
       disarm();
       if (ec) {
         dirty_ = true;
-        co_return ec;  // the line itself failed: no retry here
+        if (is_link_lost(ec)) {
+          lost_ = true;
+          if (reopen_ && !closing_) continue;  // a retriable read tries again on a new link
+        }
+        co_return ec;  // the line itself failed
       }
       if (timed_out_) {
         ++counters_.timeouts;
@@ -368,6 +497,9 @@ class basic_client {
   bool dirty_ = false;
   bool closing_ = false;
   bool timed_out_ = false;
+  bool lost_ = false;
+  std::function<void(Stream&, std::error_code&)> reopen_;
+  reconnect_policy policy_;
   std::uint64_t generation_ = 0;
   boost::asio::cancellation_signal cancel_;
   std::promise<void>* idle_ = nullptr;

@@ -16,6 +16,7 @@ enum class errc {
   no_board,          ///< baud detection found no board answering at any rate
   would_deadlock,    ///< a blocking call on the thread that must run the client's executor
   cancelled,         ///< the client was closed while the exchange waited
+  reconnect_failed,  ///< the link was lost and reopening it failed until the policy gave up
 };
 
 /** The category of rcb4::transport::errc; name() is "rcb4.transport". */
@@ -33,6 +34,7 @@ class error_category_impl final : public std::error_category {
       case errc::no_board: return "no RCB-4 answered at 115200, 625000 or 1250000 baud";
       case errc::would_deadlock: return "blocking call from the thread that runs the client's executor";
       case errc::cancelled: return "the client was closed";
+      case errc::reconnect_failed: return "the link was lost and could not be reopened (device still unplugged?)";
     }
     return "unknown rcb4.transport error";
   }
