@@ -38,6 +38,8 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <deque>
 #include <functional>
 #include <future>
@@ -197,12 +199,24 @@ class basic_client {
       ec = errc::would_deadlock;
       return {};
     }
-    std::promise<std::pair<std::error_code, response>> p;
-    auto f = p.get_future();
-    async_execute(c, [&p](boost::system::error_code e, response r) { p.set_value({std::error_code(e), r}); });
-    auto [e, r] = f.get();
-    ec = e;
-    return r;
+    struct slot {
+      std::error_code ec;
+      response r;
+      bool done = false;
+      std::mutex m;
+      std::condition_variable cv;
+    } s;  // on this stack: no shared state to allocate
+    async_execute(c, [&s](boost::system::error_code e, response r) {
+      std::lock_guard lock(s.m);  // notify under the lock: the waiter cannot leave (and free s) before unlock
+      s.ec = e;
+      s.r = r;
+      s.done = true;
+      s.cv.notify_one();
+    });
+    std::unique_lock lock(s.m);
+    s.cv.wait(lock, [&s] { return s.done; });
+    ec = s.ec;
+    return s.r;
   }
   /** Blocking; throws std::system_error on any error (a NACK included). */
   response execute(const command& c) {
