@@ -1,186 +1,121 @@
-// rcb4 — the command-line tool. Today: `rcb4 serve`, a virtual RCB-4 board on a pty or TCP.
+// rcb4 — the command-line tool: talk to an RCB-4 (or the virtual one), or be one.
 // SPDX-License-Identifier: BSL-1.0
-#include <rcb4/board/virtual_board.hpp>
-#include <rcb4/transport/board_server.hpp>
+#include "cli.hpp"
 
-#include <fmt/core.h>
-#include <boost/asio.hpp>
+#include <rcb4/transport/error.hpp>
 
-#include <charconv>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
-#include <string>
-#include <string_view>
-#include <vector>
+
+namespace cli {
+std::string_view device_help();
+}
 
 namespace {
 
-// Exit codes: distinct per kind of failure.
-constexpr int exit_ok = 0;
-constexpr int exit_usage = 2;
-constexpr int exit_io = 3;
+constexpr std::string_view usage_top = R"(rcb4 — talk to KONDO RCB-4 boards (KHR-3HV, KXR), or be one.
 
-constexpr std::string_view usage_top = R"(rcb4 — talk to KONDO RCB-4 boards, or be one.
+usage: rcb4 [global options] COMMAND [ARGS]      (`rcb4 COMMAND --help` for each command)
 
-usage: rcb4 <command> [options]
+global options:
+  --device D      /dev/ttyUSB0 (serial), tcp:HOST:PORT (ser2net); default: an in-process
+                  virtual board, so every command works without a robot
+  --baud B        115200, 625000 or 1250000 (default: detected by ping)
+  --timeout MS    turnaround allowance per exchange (default 100)
+  --trace         print every frame on stderr: time, hex, meaning
+  --json          machine-readable output where the output is data
 
-commands:
-  serve     serve a virtual RCB-4 board on a pseudo-terminal or a TCP port
-  help      show this help (or `rcb4 <command> --help`)
 )";
 
-constexpr std::string_view usage_serve = R"(usage: rcb4 serve (--pty | --tcp HOST:PORT) [options]
+constexpr std::string_view usage_bottom = R"(
+  list            serial ports, recognising KONDO's adapter and FTDI
+  doctor          check permissions, dialout, udev rule, latency timer, baud: each with the fix
+  decode HEX      frames (arguments or stdin) to descriptions
+  encode CMD      a command's frame
+  serve           serve a virtual RCB-4 on a pseudo-terminal or TCP port
 
-Serves an emulated RCB-4HV until SIGINT/SIGTERM. The first line on stdout is where to connect:
-the /dev/pts/N path for --pty (open it with the usual serial settings), or HOST:PORT for --tcp
-(port 0 picks a free one; loopback unless you name another address).
-
-options:
-  --pty               serve on a new pseudo-terminal
-  --tcp HOST:PORT     serve on TCP, one client at a time (e.g. 127.0.0.1:0)
-  --pace              deliver replies at the board's line rate (11 bits per byte, 8E1)
-  --latency US        extra microseconds before each reply (USB adapter, turnaround)
-  --rom FILE          load the 256 KiB ROM image from FILE if it exists; save it there on exit
-  --series MODE       SERIES (0x11): reboot (default, as measured in 2015) or execute
-  --shift ENCODING    SHIFT counts: measured (default, 2015 report) or manual (KONDO's manual)
-  --arith-to-com      answer arithmetic with COM as destination (refused by default)
-  --strict-timing     drop frames whose bytes arrive more than 150 us apart
-  --servos N          allocated servo slots ICS 0..N-1 (default 22)
+exit codes: 0 ok, 1 the board refused or answered wrongly, 2 usage, 3 device/I/O problem,
+            4 no answer before the deadline
 )";
 
-struct usage_error {
-  std::string message;
-};
-
-std::uint32_t parse_number(std::string_view s, std::string_view what) {
-  std::uint32_t v = 0;
-  const auto r = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (r.ec != std::errc{} || r.ptr != s.data() + s.size())
-    throw usage_error{fmt::format("{}: not a number: '{}'", what, s)};
-  return v;
-}
-
-int serve(const std::vector<std::string_view>& args) {
-  using namespace rcb4;
-  bool pty = false;
-  std::string tcp;
-  std::string rom_path;
-  transport::serve_options serve_opt;
-  board::options board_opt;
-  for (std::size_t i = 0; i < args.size(); ++i) {
-    const auto a = args[i];
-    auto value = [&]() -> std::string_view {
-      if (i + 1 >= args.size()) throw usage_error{fmt::format("{} needs a value", a)};
-      return args[++i];
-    };
-    if (a == "--help" || a == "-h") {
-      fmt::print("{}", usage_serve);
-      return exit_ok;
-    } else if (a == "--pty")
-      pty = true;
-    else if (a == "--tcp")
-      tcp = value();
-    else if (a == "--pace")
-      serve_opt.pace = true;
-    else if (a == "--latency")
-      serve_opt.latency = std::chrono::microseconds(parse_number(value(), "--latency"));
-    else if (a == "--rom")
-      rom_path = value();
-    else if (a == "--series") {
-      const auto v = value();
-      if (v == "reboot")
-        board_opt.series = board::series_behaviour::reboot;
-      else if (v == "execute")
-        board_opt.series = board::series_behaviour::execute;
-      else
-        throw usage_error{fmt::format("--series: expected reboot or execute, not '{}'", v)};
-    } else if (a == "--shift") {
-      const auto v = value();
-      if (v == "measured")
-        board_opt.shift = shift_encoding::measured_2015;
-      else if (v == "manual")
-        board_opt.shift = shift_encoding::kondo_manual;
-      else
-        throw usage_error{fmt::format("--shift: expected measured or manual, not '{}'", v)};
-    } else if (a == "--arith-to-com")
-      board_opt.allow_arith_to_com = true;
-    else if (a == "--strict-timing")
-      board_opt.strict_timing = true;
-    else if (a == "--servos") {
-      const auto n = parse_number(value(), "--servos");
-      if (n > 35) throw usage_error{"--servos: at most 35 (ICS 35 is the receiver)"};
-      board_opt.servo_count = static_cast<std::uint8_t>(n);
-    } else
-      throw usage_error{fmt::format("unknown option '{}'", a)};
+/** Exit code and hint for an error from the device. */
+int report(std::string_view cmd, const std::system_error& e) {
+  const std::error_code ec = e.code();
+  namespace t = rcb4::transport;
+  int code = cli::exit_io;
+  std::string_view hint;
+  if (ec.category() == rcb4::error_category()) {
+    code = cli::exit_board;
+    if (ec == rcb4::errc::nack) hint = "the board refused the command (range, unallocated servo, or a busy program)";
+  } else if (ec == t::errc::timeout || ec == t::errc::no_board) {
+    code = cli::exit_timeout;
+    hint = "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud, or `rcb4 doctor`";
+  } else if (ec == t::errc::port_busy) {
+    hint = "another program has the port open (`fuser -v` on the device shows which)";
+  } else if (ec == std::errc::permission_denied) {
+    hint = "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)";
+  } else if (ec == std::errc::no_such_file_or_directory) {
+    hint = "no such device: `rcb4 list` shows the serial ports";
+  } else if (t::is_link_lost(ec)) {
+    hint = "the device went away (unplugged?)";
   }
-  if (pty == !tcp.empty()) throw usage_error{"give exactly one of --pty or --tcp HOST:PORT"};
-
-  board::virtual_board board(board_opt);
-  if (!rom_path.empty()) {
-    std::ifstream f(rom_path, std::ios::binary);
-    if (f) {
-      std::vector<std::uint8_t> image{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
-      if (!board.load_rom(image)) {
-        fmt::print(stderr, "rcb4 serve: {}: a ROM image is exactly {} bytes, this file has {}\n", rom_path, rom_size,
-                   image.size());
-        return exit_io;
-      }
-    }
-  }
-
-  boost::asio::io_context io;
-  std::shared_ptr<transport::board_server> server;
-  try {
-    if (pty) {
-      server = transport::board_server::serve_pty(io, board, serve_opt);
-    } else {
-      const auto colon = tcp.rfind(':');
-      if (colon == std::string::npos) throw usage_error{fmt::format("--tcp: expected HOST:PORT, not '{}'", tcp)};
-      const auto port = parse_number(std::string_view(tcp).substr(colon + 1), "--tcp port");
-      if (port > 65535) throw usage_error{fmt::format("--tcp: port {} out of range", port)};
-      boost::system::error_code ec;
-      const auto address = boost::asio::ip::make_address(tcp.substr(0, colon), ec);
-      if (ec) throw usage_error{fmt::format("--tcp: '{}' is not an IP address", tcp.substr(0, colon))};
-      server = transport::board_server::serve_tcp(io, board, {address, static_cast<std::uint16_t>(port)}, serve_opt);
-    }
-  } catch (const std::system_error& e) {
-    fmt::print(stderr, "rcb4 serve: cannot serve: {}\n", e.what());
-    return exit_io;
-  }
-  fmt::print("{}\n", server->where());
-  std::fflush(stdout);
-
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const boost::system::error_code&, int) { server->stop(); });
-  io.run();
-
-  if (!rom_path.empty()) {
-    std::ofstream f(rom_path, std::ios::binary | std::ios::trunc);
-    f.write(reinterpret_cast<const char*>(board.rom().data()), static_cast<std::streamsize>(board.rom().size()));
-    if (!f) {
-      fmt::print(stderr, "rcb4 serve: could not save the ROM to {}\n", rom_path);
-      return exit_io;
-    }
-  }
-  return exit_ok;
+  fmt::print(stderr, "rcb4 {}: {}\n", cmd, e.what());
+  if (!hint.empty()) fmt::print(stderr, "  {}\n", hint);
+  return code;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string_view> args(argv + 1, argv + argc);
+  std::vector<std::string_view> all(argv + 1, argv + argc);
+  cli::globals g;
+  cli::args a;
   try {
-    if (args.empty() || args[0] == "help" || args[0] == "--help" || args[0] == "-h") {
-      fmt::print("{}", usage_top);
-      return args.empty() ? exit_usage : exit_ok;
+    // Global options may come before or after the command (not for `serve`, which has its own).
+    std::vector<std::string_view> rest;
+    bool is_serve = false;
+    for (std::size_t i = 0; i < all.size(); ++i) {
+      const auto s = all[i];
+      auto value = [&]() -> std::string_view {
+        if (i + 1 >= all.size()) throw cli::usage_error{fmt::format("{} needs a value", s)};
+        return all[++i];
+      };
+      if (is_serve)
+        rest.push_back(s);
+      else if (s == "--device")
+        g.device = std::string(value());
+      else if (s == "--baud")
+        g.baud = static_cast<std::uint32_t>(cli::parse_int(value(), "--baud", 1200, 4000000));
+      else if (s == "--timeout")
+        g.timeout = std::chrono::milliseconds(cli::parse_int(value(), "--timeout", 1, 600000));
+      else if (s == "--trace")
+        g.trace = true;
+      else if (s == "--json")
+        g.json = true;
+      else {
+        if (rest.empty() && s == "serve") is_serve = true;
+        rest.push_back(s);
+      }
     }
-    const auto cmd = args[0];
-    args.erase(args.begin());
-    if (cmd == "serve") return serve(args);
-    throw usage_error{fmt::format("unknown command '{}'", cmd)};
-  } catch (const usage_error& e) {
-    fmt::print(stderr, "rcb4: {}\n(see rcb4 --help)\n", e.message);
-    return exit_usage;
+    if (rest.empty() || rest[0] == "help" || rest[0] == "--help" || rest[0] == "-h") {
+      fmt::print("{}commands:{}", usage_top, cli::device_help().substr(cli::device_help().find("device commands")));
+      fmt::print("{}", usage_bottom);
+      return rest.empty() ? cli::exit_usage : cli::exit_ok;
+    }
+    a.command = rest[0];
+    a.list.assign(rest.begin() + 1, rest.end());
+    if (a.command == "serve") return cli::serve(a);
+    if (a.command == "list") return cli::list(a, g);
+    if (a.command == "doctor") return cli::doctor(a, g);
+    if (a.command == "decode") return cli::decode(a, g);
+    if (a.command == "encode") return cli::encode(a, g);
+    return cli::device_command(a, g);
+  } catch (const cli::usage_error& e) {
+    fmt::print(stderr, "rcb4{}{}: {}\n(see rcb4 {}--help)\n", a.command.empty() ? "" : " ", a.command, e.message,
+               a.command.empty() ? "" : fmt::format("{} ", a.command));
+    return cli::exit_usage;
+  } catch (const std::system_error& e) {
+    return report(a.command, e);
+  } catch (const boost::system::system_error& e) {
+    return report(a.command, std::system_error(std::error_code(e.code()), e.what()));
   }
 }

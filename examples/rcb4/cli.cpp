@@ -1,0 +1,211 @@
+// rcb4 command-line tool: parsing helpers, the device session, the frame printer.
+// SPDX-License-Identifier: BSL-1.0
+#include "cli.hpp"
+
+#include <rcb4/transport/detect.hpp>
+#include <rcb4/transport/serial.hpp>
+#include <rcb4/transport/tcp.hpp>
+
+#include <unistd.h>
+
+#include <cctype>
+#include <charconv>
+#include <cstdio>
+
+namespace cli {
+
+long long parse_int(std::string_view s, std::string_view what, long long lo, long long hi) {
+  const std::string_view original = s;
+  bool negative = false;
+  if (!s.empty() && (s[0] == '-' || s[0] == '+')) {
+    negative = s[0] == '-';
+    s.remove_prefix(1);
+  }
+  int base = 10;
+  if (s.size() > 2 && s[0] == '0' && (s[1] == 'x' || s[1] == 'X')) {
+    base = 16;
+    s.remove_prefix(2);
+  }
+  unsigned long long v = 0;
+  const auto r = std::from_chars(s.data(), s.data() + s.size(), v, base);
+  if (s.empty() || r.ec != std::errc{} || r.ptr != s.data() + s.size())
+    throw usage_error{fmt::format("{}: not a number: '{}'", what, original)};
+  const long long value = negative ? -static_cast<long long>(v) : static_cast<long long>(v);
+  if (value < lo || value > hi) throw usage_error{fmt::format("{}: {} is outside {}..{}", what, original, lo, hi)};
+  return value;
+}
+
+std::vector<std::uint8_t> parse_hex(std::string_view s, std::string_view what) {
+  std::vector<std::uint8_t> out;
+  int pending = -1;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const char ch = s[i];
+    if (ch == ' ' || ch == ',' || ch == ':' || ch == '\t' || ch == '\n' || ch == '\r') {
+      if (pending >= 0) throw usage_error{fmt::format("{}: odd number of hex digits before position {}", what, i)};
+      continue;
+    }
+    if (ch == '0' && i + 1 < s.size() && (s[i + 1] == 'x' || s[i + 1] == 'X') && pending < 0) {
+      ++i;
+      continue;
+    }
+    if (!std::isxdigit(static_cast<unsigned char>(ch)))
+      throw usage_error{fmt::format("{}: '{}' is not a hex digit", what, ch)};
+    const int d = std::isdigit(static_cast<unsigned char>(ch)) ? ch - '0' : (std::tolower(ch) - 'a' + 10);
+    if (pending < 0) {
+      pending = d;
+    } else {
+      out.push_back(static_cast<std::uint8_t>(pending * 16 + d));
+      pending = -1;
+    }
+  }
+  if (pending >= 0) throw usage_error{fmt::format("{}: odd number of hex digits", what)};
+  return out;
+}
+
+namespace {
+/** Wraps an open descriptor (its own dup: the lock and TIOCEXCL stay with the open file). */
+stream adopt(boost::asio::io_context& io, int fd) {
+  const int own = ::dup(fd);
+  if (own < 0) throw std::system_error(errno, std::generic_category(), "dup");
+  return stream(io, own);
+}
+}  // namespace
+
+session::session(const globals& g) {
+  rcb4::transport::client_options opt;
+  opt.turnaround = g.timeout;
+  if (g.trace) {
+    auto printer = std::make_shared<frame_printer>();
+    const auto start = std::chrono::steady_clock::now();
+    opt.trace = [printer, start](rcb4::transport::direction d, std::chrono::steady_clock::time_point t,
+                                 std::span<const std::uint8_t> b) {
+      const double ms = std::chrono::duration<double, std::milli>(t - start).count();
+      if (d == rcb4::transport::direction::tx)
+        fmt::print(stderr, "{:10.3f} ms  -> {}\n", ms, printer->request(b));
+      else
+        for (const auto& line : printer->received(b)) fmt::print(stderr, "{:10.3f} ms  <- {}\n", ms, line);
+    };
+  }
+  std::string path = g.device;
+  if (path.empty()) {
+    board_ = std::make_unique<rcb4::board::virtual_board>();
+    board_io_ = std::make_unique<rcb4::transport::io_thread>();
+    server_ = rcb4::transport::board_server::serve_pty(board_io_->context(), *board_);
+    path = server_->where();
+    where_ = fmt::format("the in-process virtual board ({})", path);
+  } else {
+    where_ = path;
+  }
+  if (path.rfind("tcp:", 0) == 0) {
+    serial_ = false;
+    baud_ = g.baud.value_or(115200);  // the bridge's line rate is unknown: the slowest gives safe deadlines
+    auto socket = rcb4::transport::connect(io_.context(), path.substr(4));
+    opt.baud = baud_;
+    client_ = std::make_unique<client>(adopt(io_.context(), socket.native_handle()), opt);
+    return;
+  }
+  if (g.baud) {
+    baud_ = *g.baud;
+  } else {
+    std::error_code ec;
+    baud_ = rcb4::transport::detect_baud(io_.context(), path, ec, std::max(g.timeout, std::chrono::milliseconds(50)));
+    if (ec) throw std::system_error(ec, path);
+  }
+  auto port = rcb4::transport::open_serial(io_.context(), path, baud_);
+  opt.baud = baud_;
+  client_ = std::make_unique<client>(adopt(io_.context(), port.native_handle()), opt);
+}
+
+session::~session() {
+  client_.reset();
+  if (server_) {
+    auto s = server_;
+    boost::asio::post(board_io_->context(), [s] { s->stop(); });
+  }
+  board_io_.reset();  // joins the board's thread
+}
+
+void session::follow_baud(std::uint32_t bps) {
+  if (serial_) {
+    const auto got = rcb4::transport::detail::set_custom_baud(client_->stream().native_handle(), bps);
+    if (!got) throw std::system_error(rcb4::transport::errc::unsupported_baud, where_);
+  }
+  baud_ = bps;
+  client_->options().baud = bps;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+std::string frame_printer::request(std::span<const std::uint8_t> frame) {
+  const auto r = rcb4::parse_command(frame);
+  if (r.status != rcb4::parse_status::complete) {
+    expected_.reset();
+    return fmt::format("{:<30}  (not a request: {})", rcb4::hex(frame),
+                       r.status == rcb4::parse_status::error ? rcb4::message(r.error) : "incomplete");
+  }
+  expected_ = rcb4::expected_reply(r.value);
+  return fmt::format("{:<30}  {}", rcb4::hex(frame), r.value);
+}
+
+std::vector<std::string> frame_printer::received(std::span<const std::uint8_t> bytes) {
+  rx_.insert(rx_.end(), bytes.begin(), bytes.end());
+  std::vector<std::string> lines;
+  while (!rx_.empty()) {
+    const auto r = expected_ ? rcb4::parse_reply(rx_, *expected_) : rcb4::parse_reply_frame(rx_);
+    if (r.status == rcb4::parse_status::need_more) break;
+    const std::size_t n = r.status == rcb4::parse_status::complete ? r.consumed : std::max<std::size_t>(r.consumed, 1);
+    const auto frame = std::span<const std::uint8_t>(rx_).first(std::min(n, rx_.size()));
+    if (r.status == rcb4::parse_status::complete)
+      lines.push_back(fmt::format("{:<30}  {}", rcb4::hex(frame), r.value));
+    else
+      lines.push_back(fmt::format("{:<30}  (bad reply: {})", rcb4::hex(frame), rcb4::message(r.error)));
+    rx_.erase(rx_.begin(), rx_.begin() + static_cast<std::ptrdiff_t>(frame.size()));
+    expected_.reset();
+  }
+  return lines;
+}
+
+std::vector<std::string> frame_printer::decode(std::span<const std::uint8_t> bytes) {
+  std::vector<std::string> lines;
+  std::size_t at = 0;
+  while (at < bytes.size()) {
+    const auto rest = bytes.subspan(at);
+    // After a request, its reply is expected (its shape resolves the 1-byte-data/NACK look-alike).
+    if (expected_) {
+      const auto rep = rcb4::parse_reply(rest, *expected_);
+      if (rep.status == rcb4::parse_status::complete) {
+        lines.push_back(fmt::format("reply    {:<30}  {}", rcb4::hex(rest.first(rep.consumed)), rep.value));
+        at += rep.consumed;
+        expected_.reset();
+        continue;
+      }
+    }
+    const auto req = rcb4::parse_command(rest);
+    if (req.status == rcb4::parse_status::complete) {
+      lines.push_back(fmt::format("request  {:<30}  {}", rcb4::hex(rest.first(req.consumed)), req.value));
+      expected_ = rcb4::expected_reply(req.value);
+      at += req.consumed;
+      continue;
+    }
+    const auto rep = rcb4::parse_reply_frame(rest);
+    if (rep.status == rcb4::parse_status::complete) {
+      lines.push_back(fmt::format("reply    {:<30}  {}", rcb4::hex(rest.first(rep.consumed)), rep.value));
+      at += rep.consumed;
+      expected_.reset();
+      continue;
+    }
+    if (req.status == rcb4::parse_status::need_more && rep.status == rcb4::parse_status::need_more) {
+      lines.push_back(fmt::format("partial  {:<30}  (incomplete frame: {} more bytes expected)", rcb4::hex(rest),
+                                  req.needed));
+      break;
+    }
+    const std::size_t n = std::min(rest.size(), std::max<std::size_t>(1, req.consumed));
+    lines.push_back(fmt::format("invalid  {:<30}  ({})", rcb4::hex(rest.first(n)),
+                                rcb4::message(req.status == rcb4::parse_status::error ? req.error : rep.error)));
+    at += n;
+    expected_.reset();
+  }
+  return lines;
+}
+
+}  // namespace cli
