@@ -195,8 +195,8 @@ std::vector<std::string> frame_printer::decode(std::span<const std::uint8_t> byt
       continue;
     }
     if (req.status == rcb4::parse_status::need_more && rep.status == rcb4::parse_status::need_more) {
-      lines.push_back(fmt::format("partial  {:<30}  (incomplete frame: {} more bytes expected)", rcb4::hex(rest),
-                                  req.needed));
+      lines.push_back(
+          fmt::format("partial  {:<30}  (incomplete frame: {} more bytes expected)", rcb4::hex(rest), req.needed));
       break;
     }
     const std::size_t n = std::min(rest.size(), std::max<std::size_t>(1, req.consumed));

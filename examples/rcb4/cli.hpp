@@ -9,8 +9,8 @@
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/operations.hpp>
 
-#include <boost/asio/posix/stream_descriptor.hpp>
 #include <fmt/core.h>
+#include <boost/asio/posix/stream_descriptor.hpp>
 
 #include <chrono>
 #include <memory>
@@ -35,11 +35,11 @@ struct usage_error {
 
 /** Options every device subcommand takes. */
 struct globals {
-  std::string device;                     ///< empty: the in-process virtual board
-  std::optional<std::uint32_t> baud;      ///< empty: detect (serial) or 1250000 (TCP)
+  std::string device;                      ///< empty: the in-process virtual board
+  std::optional<std::uint32_t> baud;       ///< empty: detect (serial) or 1250000 (TCP)
   std::chrono::milliseconds timeout{100};  ///< turnaround allowance per exchange
-  bool trace = false;                     ///< print every frame with its meaning
-  bool json = false;                      ///< machine-readable output
+  bool trace = false;                      ///< print every frame with its meaning
+  bool json = false;                       ///< machine-readable output
 };
 
 /** The arguments of one subcommand, with its name for messages. */

@@ -17,7 +17,8 @@ namespace {
 using namespace std::chrono_literals;
 using rcb4::ics_number;
 
-constexpr std::string_view help_text = R"(usage: rcb4 [--device D] [--baud B] [--timeout MS] [--trace] [--json] COMMAND ...
+constexpr std::string_view help_text =
+    R"(usage: rcb4 [--device D] [--baud B] [--timeout MS] [--trace] [--json] COMMAND ...
 
 device commands (no --device: an in-process virtual board, so all of them work without a robot):
   ping [--count N]                  round trip to the board
@@ -153,9 +154,8 @@ void print_config(const rcb4::config_word& c, const globals& g) {
     fmt::print(
         "{{\"word\":{},\"ics\":{},\"program\":{},\"interp_message\":{},\"vector_jump\":{},\"period_ms\":{},"
         "\"baud\":{},\"zero\":{},\"carry\":{},\"program_error\":{},\"ics_baud\":{},\"led\":{}}}\n",
-        c.encode(), c.ics_enabled, c.rom_program, c.interpolation_message, c.vector_jump,
-        rcb4::milliseconds(c.period), bits_per_second(c.com_baud), c.zero_flag, c.carry_flag, c.program_error,
-        bits_per_second(c.ics_baud), c.led);
+        c.encode(), c.ics_enabled, c.rom_program, c.interpolation_message, c.vector_jump, rcb4::milliseconds(c.period),
+        bits_per_second(c.com_baud), c.zero_flag, c.carry_flag, c.program_error, bits_per_second(c.ics_baud), c.led);
     return;
   }
   fmt::print("config 0x{:04X}\n", c.encode());
@@ -163,7 +163,8 @@ void print_config(const rcb4::config_word& c, const globals& g) {
   fmt::print("  program         {:<8} ROM program runs (bit 1)\n", on_off(c.rom_program));
   fmt::print("  interp-message  {:<8} message at the end of interpolation (bit 2)\n", on_off(c.interpolation_message));
   fmt::print("  vector-jump     {:<8} (bit 3)\n", on_off(c.vector_jump));
-  fmt::print("  period          {:<8} servo output period (bits 4-5)\n", fmt::format("{} ms", rcb4::milliseconds(c.period)));
+  fmt::print("  period          {:<8} servo output period (bits 4-5)\n",
+             fmt::format("{} ms", rcb4::milliseconds(c.period)));
   fmt::print("  baud            {:<8} COM rate (bits 6-7)\n", bits_per_second(c.com_baud));
   fmt::print("  zero, carry     {}, {}\n", on_off(c.zero_flag), on_off(c.carry_flag));
   fmt::print("  program-error   {}\n", on_off(c.program_error));
@@ -200,7 +201,7 @@ int config_cmd(session& s, const parsed& p, const globals& g) {
     if (eq == std::string_view::npos) throw usage_error{fmt::format("config set: expected KEY=VALUE, not '{}'", kv)};
     const auto key = kv.substr(0, eq), value = kv.substr(eq + 1);
     static constexpr std::string_view keys[] = {"ics", "program", "vector-jump", "interp-message",
-                                                "led", "period", "ics-baud",    "baud"};
+                                                "led", "period",  "ics-baud",    "baud"};
     if (std::find(std::begin(keys), std::end(keys), key) == std::end(keys))
       throw usage_error{fmt::format("config set: unknown key '{}'", key)};
     if (key == "baud")
@@ -230,8 +231,7 @@ int config_cmd(session& s, const parsed& p, const globals& g) {
     s.run(rcb4::ops::switch_baud(*new_baud));
     s.follow_baud(*new_baud);
     s.c().execute(rcb4::ping{});
-    if (!g.json)
-      fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *new_baud);
+    if (!g.json) fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *new_baud);
   }
   print_config(s.run(rcb4::ops::read_config{}), g);
   return exit_ok;
@@ -385,16 +385,17 @@ int servo_cmd(session& s, const parsed& p, const globals& g) {
   }
   if (sub == "free" || sub == "hold") {
     const auto which = parse_servos(p, 1);
-    const auto done = s.run(rcb4::ops::set_servo_power(
-        sub == "free" ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, which));
-    if (!g.json) fmt::print("{} {} servo{}\n", sub == "free" ? "freed" : "holding", done.size(), done.size() == 1 ? "" : "s");
+    const auto done = s.run(
+        rcb4::ops::set_servo_power(sub == "free" ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, which));
+    if (!g.json)
+      fmt::print("{} {} servo{}\n", sub == "free" ? "freed" : "holding", done.size(), done.size() == 1 ? "" : "s");
     return exit_ok;
   }
   if (sub == "speed" || sub == "stretch") {
     const auto v = checked<rcb4::servo_param>(parse_int(word(p, 1, "VALUE (1..127)"), "VALUE", 1, 127), "VALUE");
     const auto which = parse_servos(p, 2);
-    const auto done = s.run(rcb4::ops::set_servo_param(
-        sub == "speed" ? rcb4::param_kind::speed : rcb4::param_kind::stretch, v, which));
+    const auto done = s.run(
+        rcb4::ops::set_servo_param(sub == "speed" ? rcb4::param_kind::speed : rcb4::param_kind::stretch, v, which));
     if (!g.json) fmt::print("{} = {} on {} servo{}\n", sub, v.value(), done.size(), done.size() == 1 ? "" : "s");
     return exit_ok;
   }
@@ -405,12 +406,10 @@ int servo_cmd(session& s, const parsed& p, const globals& g) {
 
 std::string button_names(std::uint16_t b) {
   static constexpr std::pair<rcb4::krr_button, std::string_view> names[] = {
-      {rcb4::krr_button::up, "up"},         {rcb4::krr_button::down, "down"},
-      {rcb4::krr_button::right, "right"},   {rcb4::krr_button::left, "left"},
-      {rcb4::krr_button::triangle, "tri"},  {rcb4::krr_button::cross, "cross"},
-      {rcb4::krr_button::circle, "circle"}, {rcb4::krr_button::square, "square"},
-      {rcb4::krr_button::s1, "S1"},         {rcb4::krr_button::s2, "S2"},
-      {rcb4::krr_button::s3, "S3"},         {rcb4::krr_button::s4, "S4"}};
+      {rcb4::krr_button::up, "up"},         {rcb4::krr_button::down, "down"},     {rcb4::krr_button::right, "right"},
+      {rcb4::krr_button::left, "left"},     {rcb4::krr_button::triangle, "tri"},  {rcb4::krr_button::cross, "cross"},
+      {rcb4::krr_button::circle, "circle"}, {rcb4::krr_button::square, "square"}, {rcb4::krr_button::s1, "S1"},
+      {rcb4::krr_button::s2, "S2"},         {rcb4::krr_button::s3, "S3"},         {rcb4::krr_button::s4, "S4"}};
   std::string out;
   for (const auto& [bit, name] : names)
     if (b & static_cast<std::uint16_t>(bit)) out += (out.empty() ? "" : "+") + std::string(name);
@@ -425,9 +424,9 @@ int sensors_cmd(session& s, const parsed& p, const globals& g) {
   if (g.json) {
     fmt::print("{{\"ad\":[");
     for (std::size_t k = 0; k < a.values.size(); ++k) fmt::print("{}{}", k ? "," : "", a.values[k]);
-    fmt::print("],\"battery_volts\":{:.2f},\"pio_direction\":{},\"pio_value\":{},\"buttons\":{},\"analog\":[{},{},{},{}]}}\n",
-               a.battery_volts, pio.direction, pio.value, rx.buttons, rx.analog[0], rx.analog[1], rx.analog[2],
-               rx.analog[3]);
+    fmt::print(
+        "],\"battery_volts\":{:.2f},\"pio_direction\":{},\"pio_value\":{},\"buttons\":{},\"analog\":[{},{},{},{}]}}\n",
+        a.battery_volts, pio.direction, pio.value, rx.buttons, rx.analog[0], rx.analog[1], rx.analog[2], rx.analog[3]);
     return exit_ok;
   }
   fmt::print("battery   {:.2f} V (AD0 = {})\n", a.battery_volts, a.values[0]);
@@ -510,8 +509,8 @@ int wait_motion(session& s, const parsed& p, const globals& g, const rcb4::rom_l
       [&](const rcb4::ops::motion_state& m) {
         if (!tty || !m.running) return;
         const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        fmt::print(stderr, "\r  motion {} running  {:5.1f} s  pc 0x{:06X} ", m.motion ? fmt::format("{}", *m.motion) : "?",
-                   t, m.program_counter);
+        fmt::print(stderr, "\r  motion {} running  {:5.1f} s  pc 0x{:06X} ",
+                   m.motion ? fmt::format("{}", *m.motion) : "?", t, m.program_counter);
       },
       layout);
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
@@ -590,9 +589,11 @@ int bench_cmd(session& s, const parsed& p, const globals& g) {
   const double ping_limit = 1e6 / wire_us(3 + 4), read_limit = 1e6 / wire_us(10 + 5),
                cycle_limit = 1e6 / wire_us(cycle_bytes);
   if (g.json) {
-    fmt::print("{{\"baud\":{},\"ping_per_s\":{:.0f},\"ping_wire_limit\":{:.0f},\"read_per_s\":{:.0f},\"read_wire_limit\":{:.0f},"
-               "\"cycle_hz\":{:.1f},\"cycle_wire_limit_hz\":{:.1f},\"cycle_bytes\":{}}}\n",
-               s.baud(), ping_rate, ping_limit, read_rate, read_limit, cycle_rate, cycle_limit, cycle_bytes);
+    fmt::print(
+        "{{\"baud\":{},\"ping_per_s\":{:.0f},\"ping_wire_limit\":{:.0f},\"read_per_s\":{:.0f},\"read_wire_limit\":{:."
+        "0f},"
+        "\"cycle_hz\":{:.1f},\"cycle_wire_limit_hz\":{:.1f},\"cycle_bytes\":{}}}\n",
+        s.baud(), ping_rate, ping_limit, read_rate, read_limit, cycle_rate, cycle_limit, cycle_bytes);
     return exit_ok;
   }
   fmt::print("rcb4 bench against {} at {} baud, {} runs each\n", s.where(), s.baud(), n);

@@ -112,7 +112,8 @@ bool in_group(const char* name) {
 }
 
 std::optional<fs::path> installed_udev_rule() {
-  for (const char* dir : {"/etc/udev/rules.d", "/usr/lib/udev/rules.d", "/lib/udev/rules.d", "/usr/local/lib/udev/rules.d"}) {
+  for (const char* dir :
+       {"/etc/udev/rules.d", "/usr/lib/udev/rules.d", "/lib/udev/rules.d", "/usr/local/lib/udev/rules.d"}) {
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(dir, ec))
       if (e.path().filename().string().find("rcb4") != std::string::npos) return e.path();
@@ -140,7 +141,8 @@ int list(const args& a, const globals& g) {
     return exit_ok;
   }
   if (ports.empty()) {
-    fmt::print("no USB serial ports found (plug in the KONDO adapter; `dmesg | tail` shows whether the kernel saw it)\n");
+    fmt::print(
+        "no USB serial ports found (plug in the KONDO adapter; `dmesg | tail` shows whether the kernel saw it)\n");
     fmt::print("without hardware, every rcb4 command works on the in-process virtual board (no --device)\n");
     return exit_ok;
   }
@@ -171,7 +173,8 @@ int doctor(const args& a, const globals& g) {
       fmt::print("[ -- ] {} is a TCP bridge: only the board check applies\n", g.device);
     candidates.push_back(g.device);
   } else {
-    report(!ports.empty(), ports.empty() ? "no USB serial adapter found" : fmt::format("{} USB serial port(s) found", ports.size()),
+    report(!ports.empty(),
+           ports.empty() ? "no USB serial adapter found" : fmt::format("{} USB serial port(s) found", ports.size()),
            "plug in the KONDO adapter (165C:0008) or the FTDI cable; `dmesg | tail` should show it; "
            "without hardware use the virtual board (rcb4 ping, no --device)");
     for (const auto& p : ports) candidates.push_back(p.path);
@@ -180,7 +183,8 @@ int doctor(const args& a, const globals& g) {
   report(root || in_group("dialout"), root ? "running as root (no group needed)" : "member of the dialout group",
          "sudo usermod -aG dialout $USER, then log out and in again (or install the udev rule below)");
   const auto rule = installed_udev_rule();
-  report(rule.has_value(), rule ? fmt::format("udev rule installed: {}", rule->string()) : "rcb4 udev rule not installed",
+  report(rule.has_value(),
+         rule ? fmt::format("udev rule installed: {}", rule->string()) : "rcb4 udev rule not installed",
          "sudo cp cmake/udev/60-rcb4.rules /etc/udev/rules.d/ && sudo udevadm control --reload && sudo udevadm trigger "
          "(cmake --install does this when installing to /usr)");
   for (const auto& path : candidates) {
@@ -320,8 +324,9 @@ int encode(const args& a, const globals& g) {
       std::string joined;
       for (std::size_t i = 3; i < w.size(); ++i) joined += std::string(w[i]) + " ";
       literal = parse_hex(joined, "BYTES");
-      cmd = mem == "ram" ? must(rcb4::move::write_ram(checked<rcb4::ram_address>(addr, "ADDR"), literal), "encode write")
-                         : must(rcb4::move::write_rom(checked<rcb4::rom_address>(addr, "ADDR"), literal), "encode write");
+      cmd = mem == "ram"
+                ? must(rcb4::move::write_ram(checked<rcb4::ram_address>(addr, "ADDR"), literal), "encode write")
+                : must(rcb4::move::write_rom(checked<rcb4::rom_address>(addr, "ADDR"), literal), "encode write");
     }
   } else if (name == "call" || name == "jump") {
     exact(2);
