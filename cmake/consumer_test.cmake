@@ -30,4 +30,28 @@ execute_process(COMMAND ${CXX} ${cflags} ${WORK}/pc.cpp -o ${WORK}/pc RESULT_VAR
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "compiling with pkg-config --cflags rcb4 failed:\n${err}")
 endif()
-message(STATUS "find_package and pkg-config consumers built and ran")
+# The installed command-line tool and udev rule.
+execute_process(COMMAND ${WORK}/prefix/bin/rcb4 encode servo 0 7500 10 RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "07 0F 00 0A 4C 1D 89")
+  message(FATAL_ERROR "the installed rcb4 tool ran wrong (${rc}): ${out}")
+endif()
+if(NOT EXISTS ${WORK}/prefix/lib/udev/rules.d/60-rcb4.rules)
+  message(FATAL_ERROR "the udev rule was not installed")
+endif()
+# A project that vendors rcb4 with add_subdirectory.
+execute_process(COMMAND ${CMAKE_COMMAND} -S ${SOURCE}/../consumer_subdir -B ${WORK}/subdir -G Ninja
+                        -DCMAKE_CXX_COMPILER=${CXX} -DRCB4_SOURCE=${SOURCE}/../..
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "configuring the add_subdirectory consumer failed:\n${out}${err}")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} --build ${WORK}/subdir --target consumer RESULT_VARIABLE rc OUTPUT_VARIABLE out
+                        ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "building the add_subdirectory consumer failed:\n${out}${err}")
+endif()
+execute_process(COMMAND ${WORK}/subdir/consumer RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0 OR NOT out MATCHES "07 0F 00 0A 4C 1D 89")
+  message(FATAL_ERROR "the add_subdirectory consumer ran wrong: ${out}")
+endif()
+message(STATUS "find_package, pkg-config and add_subdirectory consumers built and ran; the CLI and udev rule installed")

@@ -244,6 +244,15 @@ struct memory_target {
   ics_number ics{};
 };
 
+/** A usage error when @p n bytes at @p addr leave memory @p t (before anything is sent). */
+void check_range(const memory_target& t, std::uint32_t addr, std::size_t n) {
+  const std::uint32_t end = t.kind == rcb4::ops::memory::ram   ? rcb4::ram_size
+                            : t.kind == rcb4::ops::memory::rom ? rcb4::rom_size
+                                                               : 256u;
+  if (addr + n > end)
+    throw usage_error{fmt::format("{} bytes at 0x{:X} run outside the memory (it ends at 0x{:X})", n, addr, end)};
+}
+
 memory_target parse_memory(const parsed& p) {
   const auto m = word(p, 0, "memory: ram, rom or ics");
   memory_target t{rcb4::ops::memory::ram};
@@ -273,6 +282,7 @@ int read_cmd(session& s, const parsed& p, const globals& g) {
   const auto addr = static_cast<std::uint32_t>(parse_int(word(p, 1, "ADDR"), "ADDR", 0, rcb4::rom_size - 1));
   const auto len = static_cast<std::size_t>(parse_int(word(p, 2, "LEN"), "LEN", 1, rcb4::rom_size));
   no_more(p, 3);
+  check_range(t, addr, len);
   const auto bytes = s.run(rcb4::ops::read_memory(t.kind, addr, len, t.ics));
   if (g.json)
     fmt::print("{{\"address\":{},\"bytes\":{}}}\n", addr, json_bytes(bytes));
@@ -288,6 +298,7 @@ int write_cmd(session& s, const parsed& p, const globals& g) {
   for (std::size_t i = 2; i < p.positional.size(); ++i) joined += std::string(p.positional[i]) + " ";
   const auto bytes = parse_hex(joined, "BYTES");
   if (bytes.empty()) throw usage_error{"write: give the bytes to write, e.g. \"12 34\""};
+  check_range(t, addr, bytes.size());
   const auto written = s.run(rcb4::ops::write_memory(t.kind, addr, bytes, t.ics));
   const auto frames = (bytes.size() + rcb4::ops::max_write - 1) / rcb4::ops::max_write;
   if (g.json)

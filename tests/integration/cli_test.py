@@ -1,0 +1,188 @@
+#!/usr/bin/env python3
+# The rcb4 command-line tool used as a newcomer would: every subcommand, its --help, its errors
+# and exit codes, against the in-process virtual board and against an independent RCB-4 stand-in
+# written here in Python from protocol.md (no project code), on a pseudo-terminal. Expected frames
+# are written by hand from protocol.md.
+# SPDX-License-Identifier: BSL-1.0
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+import tty
+
+RCB4 = sys.argv[1]
+failures = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        failures.append(what)
+
+
+def run(*args, stdin=None, timeout=60):
+    p = subprocess.run([RCB4, *args], input=stdin, capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+class StandIn:
+    """A minimal RCB-4 on a pty (protocol.md §2, §4): ping, VERSION, MOV RAM->COM, MOV literal->RAM,
+    SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing."""
+
+    def __init__(self, silent=False):
+        self.ram = bytearray(0x490)
+        self.ram[0:2] = bytes([0x8B, 0x00])  # config word 0x008B
+        for k in range(36):  # allocation table at 0x0044: ICS 0-2 allocated at 0x0090 + 20k
+            a = 0x0090 + 20 * k if k < 3 else 0xFFFF
+            if k < 35:
+                self.ram[0x44 + 2 * k:0x46 + 2 * k] = a.to_bytes(2, "little")
+        for k in range(3):
+            self.ram[0x90 + 20 * k + 4:0x90 + 20 * k + 8] = (7500).to_bytes(2, "little") * 2
+        self.frames = []
+        self.silent = silent
+        self.master, slave = os.openpty()
+        tty.setraw(slave)
+        self.path = os.ttyname(slave)
+        self.slave = slave
+        threading.Thread(target=self.serve, daemon=True).start()
+
+    def reply(self, b):
+        os.write(self.master, bytes(b) + bytes([sum(b) & 0xFF]))
+
+    def serve(self):
+        buf = b""
+        while True:
+            try:
+                buf += os.read(self.master, 512)
+            except OSError:
+                return
+            while buf and len(buf) >= buf[0] >= 3:
+                f, buf = buf[:buf[0]], buf[buf[0]:]
+                self.frames.append(f)
+                if self.silent or sum(f[:-1]) & 0xFF != f[-1]:
+                    continue
+                cmd = f[1]
+                if cmd == 0xFE:
+                    self.reply([0x04, 0xFE, 0x06])
+                elif cmd == 0xFD:
+                    self.reply([0x23, 0xFD] + list(b"STAND-IN RCB-4 (python)".ljust(32)))
+                elif cmd == 0x00 and f[2] == 0x20 and len(f) == 10:  # RAM -> COM
+                    a, n = f[6] | f[7] << 8, f[8]
+                    self.reply([n + 3, 0x00] + list(self.ram[a:a + n]))
+                elif cmd == 0x00 and f[2] == 0x02:  # literal -> RAM
+                    a = f[3] | f[4] << 8
+                    self.ram[a:a + len(f) - 7] = f[6:-1]
+                    self.reply([0x04, 0x00, 0x06])
+                elif cmd in (0x0F, 0x10, 0x12):
+                    self.reply([0x04, cmd, 0x06])
+                else:
+                    self.reply([0x04, cmd, 0x15])
+
+
+def expect_ok(args, contains, what=None, stdin=None):
+    rc, out, err = run(*args, stdin=stdin)
+    check(rc == 0 and contains in out, (what or " ".join(args)) + (f"  (rc {rc}, out {out[:200]!r}, err {err[:200]!r})" if rc or contains not in out else ""))
+    return out
+
+
+def expect_rc(args, rc_wanted, err_contains, what=None):
+    rc, out, err = run(*args)
+    check(rc == rc_wanted and err_contains in err, (what or " ".join(args)) + f" -> exit {rc_wanted}" + (f"  (got {rc}: {err[:200]!r})" if rc != rc_wanted or err_contains not in err else ""))
+
+
+# ---- help and usage --------------------------------------------------------------------------
+expect_ok(["--help"], "exit codes")
+expect_rc([], 2, "", "no arguments")
+expect_rc(["frobnicate"], 2, "unknown command")
+for sub in ["ping", "version", "config", "read", "write", "servo", "sensors", "monitor", "motion", "bench",
+            "list", "doctor", "decode", "encode", "serve"]:
+    rc, out, err = run(sub, "--help")
+    check(rc == 0 and "usage" in out, f"{sub} --help")
+
+# ---- against the in-process virtual board (no --device) --------------------------------------
+expect_ok(["ping"], "ACK from the in-process virtual board")
+expect_ok(["ping", "--count", "20"], "20 pings")
+expect_ok(["version"], "CB-4 V1.0      090715")
+cfg = json.loads(expect_ok(["--json", "config"], "{"))
+check(cfg["word"] == 0x008B and cfg["baud"] == 1250000, "config --json: boot word 0x008B at 1.25 Mbaud")
+expect_ok(["config", "set", "period=20", "led=on"], "period          20 ms")
+expect_ok(["config", "set", "baud=115200"], "the board now speaks 115200 baud")
+expect_rc(["config", "set", "bogus=1"], 2, "unknown key")
+expect_rc(["config", "set", "period=12"], 2, "period")
+expect_ok(["read", "ram", "0x0000", "2"], "8B 00")
+expect_ok(["read", "rom", "0x000444", "4"], "0x000444")
+expect_ok(["write", "ram", "0x0400", "12 34 56"], "wrote 3 bytes at 0x000400 in 1 frame")
+expect_rc(["read", "ram", "0x0500", "2"], 2, "outside the memory")
+expect_rc(["read", "ics", "0", "2"], 2, "--ics")
+out = expect_ok(["servo", "list"], "ICS")
+check(len(out.strip().splitlines()) == 23, "servo list: 22 servos and a header")
+states = json.loads(expect_ok(["--json", "servo", "get", "0", "3"], "["))
+check([s["ics"] for s in states] == [0, 3] and states[0]["position"] == 7500, "servo get 0 3 --json")
+expect_ok(["servo", "move", "0=8000@10", "1=7000"], "moving 2 servos")
+expect_ok(["servo", "move", "--deg", "0=30"], "moving 1 servo")
+expect_rc(["servo", "move", "0=20000"], 2, "outside 0..16383")
+expect_rc(["servo", "move", "40=7500"], 2, "ICS")
+expect_rc(["servo", "get", "30"], 2, "no servo allocated")
+expect_ok(["servo", "free"], "freed 22 servos")
+expect_ok(["servo", "hold", "1", "2"], "holding 2 servos")
+expect_ok(["servo", "speed", "64"], "speed = 64 on 22 servos")
+expect_ok(["servo", "stretch", "30", "5"], "stretch = 30 on 1 servo")
+expect_rc(["servo", "stretch", "200"], 2, "outside 1..127")
+sensors = json.loads(expect_ok(["--json", "sensors"], "{"))
+check(len(sensors["ad"]) == 11 and 10.0 < sensors["battery_volts"] < 11.5, "sensors --json: 11 channels, battery")
+expect_ok(["sensors"], "battery")
+lines = expect_ok(["--json", "monitor", "--count", "3", "--hz", "20"], "sample").strip().splitlines()
+check(len(lines) == 3 and json.loads(lines[2])["sample"] == 2, "monitor --count 3 --json: three samples")
+expect_ok(["motion", "play", "2", "--wait", "--timeout", "10"], "done after")
+expect_ok(["motion", "status"], "no motion running")
+expect_ok(["motion", "stop"], "stopped")
+expect_ok(["motion", "resume"], "resumed")
+expect_rc(["motion", "play", "121"], 2, "outside 1..120")
+expect_rc(["motion", "play", "1", "--layout", "9.9"], 2, "--layout")
+expect_ok(["bench", "--count", "20"], "control cycle")
+rc, out, err = run("--trace", "ping")
+check(rc == 0 and "-> 04 FE 06 08" in err and "<- 04 FE 06 08" in err and "ACK" in err, "--trace shows frames with meaning")
+
+# ---- offline: decode / encode (golden frames by hand from protocol.md) -----------------------
+expect_ok(["decode", "07 0F 00 0A 4C 1D 89"], "SINGLE ICS 0")
+out = expect_ok(["decode"], "DATA", "decode from stdin", stdin="0A 00 20 00 00 00 00 00 02 2C\n05 00 8B 00 90\n")
+check("MOV RAM[0x0000+2]" in out and "DATA" in out, "decode: a request then its data reply")
+rc, out, err = run("decode", "07 0F 00 0A 4C 1D 88")
+check(rc == 1 and "checksum" in out, "decode: bad checksum -> exit 1")
+expect_rc(["decode", "0G"], 2, "hex digit")
+expect_ok(["encode", "servo", "0", "7500", "10"], "07 0F 00 0A 4C 1D 89")
+expect_ok(["encode", "ping"], "04 FE 06 08")
+expect_ok(["encode", "read", "ram", "0x0000", "2"], "0A 00 20 00 00 00 00 00 02 2C")
+expect_ok(["encode", "const", "10", "0=7500"], "0B 10 01 00 00 00 00 0A 4C 1D 8F")
+expect_rc(["encode", "servo", "36", "7500"], 2, "ICS")
+expect_ok(["list"], "")
+expect_ok(["serve", "--help"], "--pty")
+
+# ---- against the stand-in on a pty (not this project's board) --------------------------------
+s = StandIn()
+expect_ok(["--device", s.path, "ping"], "ACK from " + s.path)
+expect_ok(["--device", s.path, "version"], "STAND-IN RCB-4 (python)")
+expect_ok(["--device", s.path, "config"], "config 0x008B")
+out = expect_ok(["--device", s.path, "--baud", "1250000", "servo", "list"], "7500")
+check(len(out.strip().splitlines()) == 4, "stand-in: 3 allocated servos listed")
+n = len(s.frames)
+expect_ok(["--device", s.path, "--baud", "1250000", "servo", "move", "0=7500@10"], "moving 1 servo")
+check(bytes.fromhex("0B 10 01 00 00 00 00 0A 4C 1D 8F") in s.frames[n:], "stand-in received the CONST frame KONDO's libraries send")
+expect_ok(["--device", s.path, "--baud", "1250000", "write", "ram", "0x0400", "AA BB"], "wrote 2 bytes")
+check(bytes.fromhex("09 00 02 00 04 00 AA BB 74") in s.frames, "stand-in received MOV literal -> RAM 0x0400")
+expect_ok(["--device", s.path, "--baud", "1250000", "read", "ram", "0x0400", "2"], "AA BB")
+rc, out, err = run("doctor", "--device", s.path)
+check("[ ok ] board answers at" in out, "doctor --device: the board check passes")
+
+silent = StandIn(silent=True)
+t0 = time.monotonic()
+rc, out, err = run("--device", silent.path, "--baud", "1250000", "--timeout", "50", "ping")
+check(rc == 4 and "no reply" in err and time.monotonic() - t0 < 5, f"silent board: exit 4 within its deadline (rc {rc}, {time.monotonic() - t0:.2f} s)")
+rc, out, err = run("--device", silent.path, "--timeout", "20", "ping")
+check(rc == 4 and "no RCB-4 answered" in err, f"silent board, baud detection: exit 4 (rc {rc}: {err[:120]!r})")
+expect_rc(["--device", "/dev/does-not-exist", "--baud", "115200", "ping"], 3, "no such device")
+
+print(f"\n{len(failures)} failure(s)")
+sys.exit(1 if failures else 0)
