@@ -18,8 +18,11 @@ build_and_test() {
 case "${1:-}" in
   demo)
     cmake --preset dev >/dev/null
-    cmake --build --preset dev --target rcb4_codec_tour
-    ./build/dev/examples/rcb4_codec_tour
+    cmake --build --preset dev --target rcb4_demo rcb4_cli
+    ./build/dev/examples/rcb4_demo          # a virtual RCB-4 plays motion 2; the moving servos are drawn
+    echo
+    echo "next: build/dev/examples/rcb4 --help   (every command works on the virtual board without a robot)"
+
     ;;
   test)
     build_and_test dev            # GCC 12, warnings as errors: unit, static, compile-fail, fuzz replay, Cortex-M4
