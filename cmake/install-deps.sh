@@ -12,6 +12,7 @@ packages=(
   gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib  # firmware cross-compile check of the codec
   python3                              # a client in another language for the virtual board tests
   ser2net                              # TCP bridge used by the transport tests
+  doxygen                              # API documentation (the docs.doxygen test)
 )
 
 missing=()

@@ -295,7 +295,10 @@ int write_cmd(session& s, const parsed& p, const globals& g) {
   const auto t = parse_memory(p);
   const auto addr = static_cast<std::uint32_t>(parse_int(word(p, 1, "ADDR"), "ADDR", 0, rcb4::rom_size - 1));
   std::string joined;
-  for (std::size_t i = 2; i < p.positional.size(); ++i) joined += std::string(p.positional[i]) + " ";
+  for (std::size_t i = 2; i < p.positional.size(); ++i) {
+    joined += p.positional[i];
+    joined += ' ';
+  }
   const auto bytes = parse_hex(joined, "BYTES");
   if (bytes.empty()) throw usage_error{"write: give the bytes to write, e.g. \"12 34\""};
   check_range(t, addr, bytes.size());
@@ -423,7 +426,10 @@ std::string button_names(std::uint16_t b) {
       {rcb4::krr_button::s2, "S2"},         {rcb4::krr_button::s3, "S3"},         {rcb4::krr_button::s4, "S4"}};
   std::string out;
   for (const auto& [bit, name] : names)
-    if (b & static_cast<std::uint16_t>(bit)) out += (out.empty() ? "" : "+") + std::string(name);
+    if (b & static_cast<std::uint16_t>(bit)) {
+      if (!out.empty()) out += '+';
+      out += name;
+    }
   return out.empty() ? "none" : out;
 }
 

@@ -228,7 +228,10 @@ int decode(const args& a, const globals& g) {
   if (a.list.empty() || (a.list.size() == 1 && a.list[0] == "-"))
     text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
   else
-    for (auto s : a.list) text += std::string(s) + " ";
+    for (auto s : a.list) {
+      text += s;
+      text += ' ';
+    }
   const auto bytes = parse_hex(text, "decode");
   if (bytes.empty()) throw usage_error{"decode: no bytes given"};
   frame_printer printer;
@@ -322,7 +325,10 @@ int encode(const args& a, const globals& g) {
                          : must(rcb4::move::read_rom(checked<rcb4::rom_address>(addr, "ADDR"), n), "encode read");
     } else {
       std::string joined;
-      for (std::size_t i = 3; i < w.size(); ++i) joined += std::string(w[i]) + " ";
+      for (std::size_t i = 3; i < w.size(); ++i) {
+        joined += w[i];
+        joined += ' ';
+      }
       literal = parse_hex(joined, "BYTES");
       cmd = mem == "ram"
                 ? must(rcb4::move::write_ram(checked<rcb4::ram_address>(addr, "ADDR"), literal), "encode write")

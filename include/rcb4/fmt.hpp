@@ -109,6 +109,7 @@ constexpr std::string_view update_suffix(update_flags f) noexcept {
 }  // namespace fmt_detail
 }  // namespace rcb4
 
+#ifndef RCB4_DOXYGEN  // fmt::formatter specialisations: hex_view, errc, command, reply, config_word
 template <>
 struct fmt::formatter<rcb4::hex_view> : rcb4::fmt_detail::padded<fmt::formatter<rcb4::hex_view>, rcb4::hex_view> {
   template <class Out>
@@ -234,3 +235,4 @@ struct fmt::formatter<rcb4::config_word>
                           c.carry_flag ? 1 : 0, c.program_error ? "yes" : "no", c.led ? "on" : "off");
   }
 };
+#endif  // RCB4_DOXYGEN
