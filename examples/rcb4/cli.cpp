@@ -87,6 +87,7 @@ session::session(const globals& g) {
     };
   }
   std::string path = g.device;
+  std::uint32_t baud = 115200;
   if (path.empty()) {
     board_ = std::make_unique<rcb4::board::virtual_board>();
     board_io_ = std::make_unique<rcb4::transport::io_thread>();
@@ -98,21 +99,21 @@ session::session(const globals& g) {
   }
   if (path.rfind("tcp:", 0) == 0) {
     serial_ = false;
-    baud_ = g.baud.value_or(115200);  // the bridge's line rate is unknown: the slowest gives safe deadlines
+    baud = g.baud.value_or(115200);  // the bridge's line rate is unknown: the slowest gives safe deadlines
     auto socket = rcb4::transport::connect(io_.context(), path.substr(4));
-    opt.baud = baud_;
+    opt.baud = baud;
     client_ = std::make_unique<client>(adopt(io_.context(), socket.native_handle()), opt);
     return;
   }
   if (g.baud) {
-    baud_ = *g.baud;
+    baud = *g.baud;
   } else {
     std::error_code ec;
-    baud_ = rcb4::transport::detect_baud(io_.context(), path, ec, std::max(g.timeout, std::chrono::milliseconds(50)));
+    baud = rcb4::transport::detect_baud(io_.context(), path, ec, std::max(g.timeout, std::chrono::milliseconds(50)));
     if (ec) throw std::system_error(ec, path);
   }
-  auto port = rcb4::transport::open_serial(io_.context(), path, baud_);
-  opt.baud = baud_;
+  auto port = rcb4::transport::open_serial(io_.context(), path, baud);
+  opt.baud = baud;
   client_ = std::make_unique<client>(adopt(io_.context(), port.native_handle()), opt);
 }
 
@@ -123,15 +124,6 @@ session::~session() {
     boost::asio::post(board_io_->context(), [s] { s->stop(); });
   }
   board_io_.reset();  // joins the board's thread
-}
-
-void session::follow_baud(std::uint32_t bps) {
-  if (serial_) {
-    const auto got = rcb4::transport::detail::set_custom_baud(client_->stream().native_handle(), bps);
-    if (!got) throw std::system_error(rcb4::transport::errc::unsupported_baud, where_);
-  }
-  baud_ = bps;
-  client_->options().baud = bps;
 }
 
 // ---------------------------------------------------------------------------------------------

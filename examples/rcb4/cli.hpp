@@ -77,7 +77,7 @@ class session {
   /** The client. */
   client& c() { return *client_; }
   /** The baud in use (deadlines; the wire rate on a serial port). */
-  std::uint32_t baud() const noexcept { return baud_; }
+  std::uint32_t baud() const noexcept { return client_->options().baud; }
   /** What was opened, for messages. */
   const std::string& where() const noexcept { return where_; }
   /** True when this is a serial device (not TCP). */
@@ -89,8 +89,6 @@ class session {
   auto run(Op op) {
     return rcb4::transport::run(*client_, std::move(op));
   }
-  /** Follows a baud change on the host side (the board was switched already). */
-  void follow_baud(std::uint32_t bps);
 
  private:
   std::unique_ptr<rcb4::board::virtual_board> board_;
@@ -98,7 +96,6 @@ class session {
   std::shared_ptr<rcb4::transport::board_server> server_;
   rcb4::transport::io_thread io_;
   std::unique_ptr<client> client_;
-  std::uint32_t baud_ = 1250000;
   std::string where_;
   bool serial_ = true;
 };

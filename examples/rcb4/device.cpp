@@ -228,9 +228,7 @@ int config_cmd(session& s, const parsed& p, const globals& g) {
   apply(probe);
   if (!changes.empty()) s.run(rcb4::ops::update_config(apply));
   if (new_baud) {
-    s.run(rcb4::ops::switch_baud(*new_baud));
-    s.follow_baud(*new_baud);
-    s.c().execute(rcb4::ping{});
+    rcb4::transport::switch_baud(s.c(), *new_baud);  // the board, then this port, then a ping
     if (!g.json) fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *new_baud);
   }
   print_config(s.run(rcb4::ops::read_config{}), g);

@@ -14,6 +14,8 @@
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_future.hpp>
 
+#include <unistd.h>
+
 #include <functional>
 
 namespace rcb4::transport {
@@ -41,21 +43,30 @@ auto run(basic_client<Stream>& c, Op op) {
   return op.value();
 }
 
+namespace detail {
+/** Runs @p op to the end in a coroutine; the error of the line or of the operation, if any. */
+template <AsyncByteStream Stream, ops::Operation Op>
+boost::asio::awaitable<std::error_code> async_run_ec(basic_client<Stream>& c, Op& op) {
+  while (auto cmd = op.next()) {
+    auto [ec, r] = co_await c.async_execute(*cmd, boost::asio::as_tuple(boost::asio::use_awaitable));
+    if (ec && std::error_code(ec) != rcb4::errc::nack) co_return std::error_code(ec);  // the line failed
+    op.on_reply(r.view());  // a NACK is the operation's to judge
+  }
+  co_return op.error() != rcb4::errc{} ? std::error_code(op.error()) : std::error_code{};
+}
+}  // namespace detail
+
 /** Coroutine form: co_await async_run(client, op) → the operation's value; throws on failure. */
 template <AsyncByteStream Stream, ops::Operation Op>
 boost::asio::awaitable<std::decay_t<decltype(std::declval<Op&>().value())>> async_run(basic_client<Stream>& c, Op op) {
-  while (auto cmd = op.next()) {
-    auto [ec, r] = co_await c.async_execute(*cmd, boost::asio::as_tuple(boost::asio::use_awaitable));
-    if (ec && std::error_code(ec) != rcb4::errc::nack) throw boost::system::system_error(ec, "rcb4 operation");
-    op.on_reply(r.view());
-  }
-  if (op.error() != rcb4::errc{}) throw std::system_error(op.error(), "rcb4 operation");
+  if (const auto ec = co_await detail::async_run_ec(c, op)) throw std::system_error(ec, "rcb4 operation");
   co_return op.value();
 }
 
 /**
  * Switches the board's COM rate to @p bps and follows it on the host: the board acknowledges at
- * the old rate (protocol.md §9), then a serial port is set to the new rate (termios2, read back),
+ * the old rate (protocol.md §9), then a serial port (any stream whose descriptor is a tty) is set
+ * to the new rate (termios2, read back),
  * the client's deadlines are recomputed, and a ping confirms the board answers. Other streams
  * (TCP to ser2net) only get the deadlines: switch the bridge's rate yourself. Call it while no
  * other thread uses the client. The change is RAM-only: a power cycle restores the ROM rate.
@@ -65,11 +76,14 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps, std::error_code& ec
   auto op = ops::switch_baud(bps);
   run(c, op, ec);
   if (ec) return;
-  if constexpr (std::same_as<Stream, boost::asio::serial_port>) {
-    const auto got = detail::set_custom_baud(c.stream().native_handle(), bps);
-    if (!got || (*got > bps ? *got - bps : bps - *got) > bps / 50) {
-      ec = errc::unsupported_baud;  // the board moved but this port cannot follow
-      return;
+  if constexpr (requires { c.stream().native_handle(); }) {
+    const int fd = c.stream().native_handle();
+    if (::isatty(fd)) {  // a serial port (also when wrapped as a plain descriptor); not a socket
+      const auto got = detail::set_custom_baud(fd, bps);
+      if (!got || (*got > bps ? *got - bps : bps - *got) > bps / 50) {
+        ec = errc::unsupported_baud;  // the board moved but this port cannot follow
+        return;
+      }
     }
   }
   c.options().baud = bps;
@@ -98,12 +112,7 @@ boost::asio::awaitable<std::pair<std::error_code, ops::motion_state>> wait_motio
   boost::asio::steady_timer timer(co_await boost::asio::this_coro::executor);
   for (;;) {
     ops::read_motion_state op(layout);
-    while (auto cmd = op.next()) {
-      auto [ec, r] = co_await c.async_execute(*cmd, boost::asio::as_tuple(boost::asio::use_awaitable));
-      if (ec && std::error_code(ec) != rcb4::errc::nack) co_return std::pair{std::error_code(ec), op.value()};
-      op.on_reply(r.view());
-    }
-    if (op.error() != rcb4::errc{}) co_return std::pair{std::error_code(op.error()), op.value()};
+    if (const auto ec = co_await async_run_ec(c, op)) co_return std::pair{ec, op.value()};
     if (progress) progress(op.value());
     if (!op.value().running) co_return std::pair{std::error_code{}, op.value()};
     const auto now = std::chrono::steady_clock::now();
