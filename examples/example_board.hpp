@@ -10,6 +10,7 @@
 #include <rcb4/transport/serial.hpp>
 
 #include <cstdio>
+#include <future>
 #include <memory>
 #include <string>
 
@@ -43,7 +44,15 @@ struct connection {
   }
   ~connection() {
     client.reset();
-    if (server) boost::asio::post(board_io->context(), [s = server] { s->stop(); });
+    if (server) {  // stop on the board's thread and wait, then release it while its context lives
+      std::promise<void> stopped;
+      boost::asio::post(board_io->context(), [&] {
+        server->stop();
+        stopped.set_value();
+      });
+      stopped.get_future().wait();
+      server.reset();
+    }
   }
   connection(const connection&) = delete;
   connection& operator=(const connection&) = delete;

@@ -8,6 +8,7 @@
 #include <rcb4/transport/tcp.hpp>
 
 #include <cstdio>
+#include <future>
 
 int main(int argc, char** argv) try {
   using namespace rcb4;
@@ -33,7 +34,15 @@ int main(int argc, char** argv) try {
               static_cast<unsigned long long>(c.counters().exchanges.load()),
               static_cast<unsigned long long>(c.counters().bytes_out.load()),
               static_cast<unsigned long long>(c.counters().bytes_in.load()));
-  if (server) boost::asio::post(server_io.context(), [server] { server->stop(); });
+  if (server) {  // stop on the server's thread and wait, then release it while its context lives
+    std::promise<void> stopped;
+    boost::asio::post(server_io.context(), [&] {
+      server->stop();
+      stopped.set_value();
+    });
+    stopped.get_future().wait();
+    server.reset();
+  }
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "tcp_bridge: %s\n", e.what());

@@ -11,6 +11,7 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
+#include <future>
 
 namespace cli {
 
@@ -119,9 +120,14 @@ session::session(const globals& g) {
 
 session::~session() {
   client_.reset();
-  if (server_) {
-    auto s = server_;
-    boost::asio::post(board_io_->context(), [s] { s->stop(); });
+  if (server_) {  // stop on the board's thread and wait, then release it while its context lives
+    std::promise<void> stopped;
+    boost::asio::post(board_io_->context(), [&] {
+      server_->stop();
+      stopped.set_value();
+    });
+    stopped.get_future().wait();
+    server_.reset();
   }
   board_io_.reset();  // joins the board's thread
 }
