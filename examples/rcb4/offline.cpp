@@ -7,6 +7,7 @@
 #include <grp.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -33,10 +34,16 @@ std::string read_line(const fs::path& p) {
   return s;
 }
 
+/** Where sysfs is: /sys, or $RCB4_SYSFS_ROOT (the tests point it at a fake tree). */
+fs::path sysfs() {
+  const char* root = std::getenv("RCB4_SYSFS_ROOT");
+  return root && *root ? fs::path(root) : fs::path("/sys");
+}
+
 std::vector<port_info> find_ports() {
   std::vector<port_info> out;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator("/sys/class/tty", ec)) {
+  for (const auto& e : fs::directory_iterator(sysfs() / "class/tty", ec)) {
     const auto name = e.path().filename().string();
     if (name.rfind("ttyUSB", 0) != 0 && name.rfind("ttyACM", 0) != 0) continue;
     port_info p;
@@ -49,7 +56,7 @@ std::vector<port_info> find_ports() {
         p.product = read_line(dev / "product");
         break;
       }
-    std::ifstream t("/sys/bus/usb-serial/devices/" + name + "/latency_timer");
+    std::ifstream t(sysfs() / "bus/usb-serial/devices" / name / "latency_timer");
     unsigned ms = 0;
     if (t >> ms) p.latency = ms;
     if (p.vid == "165c" && p.pid == "0008")

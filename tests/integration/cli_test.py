@@ -158,6 +158,26 @@ expect_ok(["encode", "read", "ram", "0x0000", "2"], "0A 00 20 00 00 00 00 00 02 
 expect_ok(["encode", "const", "10", "0=7500"], "0B 10 01 00 00 00 00 0A 4C 1D 8F")
 expect_rc(["encode", "servo", "36", "7500"], 2, "ICS")
 expect_ok(["list"], "")
+# `list` on a fake sysfs tree: a KONDO adapter and an FTDI cable, as the kernel lays them out.
+import tempfile
+with tempfile.TemporaryDirectory() as root:
+    for tty_name, usb, vid, pid, product, latency in [("ttyUSB0", "1-1", "165c", "0008", "Dual USB Adapter HS", 1),
+                                                       ("ttyUSB1", "1-2", "0403", "6001", "FT232R USB UART", 16)]:
+        iface = os.path.join(root, "devices/pci0000:00/usb1", usb, usb + ":1.0", tty_name)
+        os.makedirs(iface)
+        for f, v in [("idVendor", vid), ("idProduct", pid), ("product", product)]:
+            with open(os.path.join(root, "devices/pci0000:00/usb1", usb, f), "w") as fh:
+                fh.write(v + "\n")
+        os.makedirs(os.path.join(root, "class/tty", tty_name))
+        os.symlink(iface, os.path.join(root, "class/tty", tty_name, "device"))
+        os.makedirs(os.path.join(root, "bus/usb-serial/devices", tty_name))
+        with open(os.path.join(root, "bus/usb-serial/devices", tty_name, "latency_timer"), "w") as fh:
+            fh.write(f"{latency}\n")
+    p = subprocess.run([RCB4, "--json", "list"], capture_output=True, text=True, env={**os.environ, "RCB4_SYSFS_ROOT": root})
+    ports = json.loads(p.stdout)
+    check(len(ports) == 2 and ports[0]["path"] == "/dev/ttyUSB0" and ports[0]["kind"].startswith("KONDO")
+          and ports[0]["latency_ms"] == 1 and ports[1]["kind"] == "FTDI USB serial" and ports[1]["latency_ms"] == 16,
+          f"list: recognises KONDO 165C:0008 and FTDI on a fake sysfs ({p.stdout[:200]!r})")
 expect_ok(["serve", "--help"], "--pty")
 
 # ---- against the stand-in on a pty (not this project's board) --------------------------------
