@@ -39,10 +39,10 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <mutex>
 #include <deque>
 #include <functional>
 #include <future>
+#include <mutex>
 #include <system_error>
 #include <thread>
 
