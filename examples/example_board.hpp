@@ -10,7 +10,6 @@
 #include <rcb4/transport/serial.hpp>
 
 #include <cstdio>
-#include <future>
 #include <memory>
 #include <string>
 
@@ -44,15 +43,7 @@ struct connection {
   }
   ~connection() {
     client.reset();
-    if (server) {  // stop on the board's thread and wait, then release it while its context lives
-      std::promise<void> stopped;
-      boost::asio::post(board_io->context(), [&] {
-        server->stop();
-        stopped.set_value();
-      });
-      stopped.get_future().wait();
-      server.reset();
-    }
+    rcb4::transport::board_server::shutdown(server);  // before board_io's context goes
   }
   connection(const connection&) = delete;
   connection& operator=(const connection&) = delete;

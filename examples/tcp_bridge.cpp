@@ -8,7 +8,6 @@
 #include <rcb4/transport/tcp.hpp>
 
 #include <cstdio>
-#include <future>
 
 int main(int argc, char** argv) try {
   using namespace rcb4;
@@ -34,15 +33,7 @@ int main(int argc, char** argv) try {
               static_cast<unsigned long long>(c.counters().exchanges.load()),
               static_cast<unsigned long long>(c.counters().bytes_out.load()),
               static_cast<unsigned long long>(c.counters().bytes_in.load()));
-  if (server) {  // stop on the server's thread and wait, then release it while its context lives
-    std::promise<void> stopped;
-    boost::asio::post(server_io.context(), [&] {
-      server->stop();
-      stopped.set_value();
-    });
-    stopped.get_future().wait();
-    server.reset();
-  }
+  transport::board_server::shutdown(server);  // before server_io's context goes
   return 0;
 } catch (const std::exception& e) {
   std::fprintf(stderr, "tcp_bridge: %s\n", e.what());

@@ -11,7 +11,6 @@
 #include <cctype>
 #include <charconv>
 #include <cstdio>
-#include <future>
 
 namespace cli {
 
@@ -120,16 +119,8 @@ session::session(const globals& g) {
 
 session::~session() {
   client_.reset();
-  if (server_) {  // stop on the board's thread and wait, then release it while its context lives
-    std::promise<void> stopped;
-    boost::asio::post(board_io_->context(), [&] {
-      server_->stop();
-      stopped.set_value();
-    });
-    stopped.get_future().wait();
-    server_.reset();
-  }
-  board_io_.reset();  // joins the board's thread
+  rcb4::transport::board_server::shutdown(server_);  // before board_io_'s context goes
+  board_io_.reset();                                 // joins the board's thread
 }
 
 // ---------------------------------------------------------------------------------------------

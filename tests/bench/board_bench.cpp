@@ -10,7 +10,6 @@
 #include <benchmark/benchmark.h>
 
 #include <cstdio>
-#include <future>
 #include <thread>
 
 namespace {
@@ -62,12 +61,7 @@ int main(int argc, char** argv) {
       echo_us += rcb4::testing::pty_round_trips(echo_pty.path(), ping_frame, 4, n) / 2;
       serve_us += rcb4::testing::pty_round_trips(server->where(), ping_frame, 4, n) / 2;
     }
-    std::promise<void> stopped;  // the board must outlive the server's last use of it
-    boost::asio::post(io, [&] {
-      server->stop();
-      stopped.set_value();
-    });
-    stopped.get_future().wait();
+    transport::board_server::shutdown(server);  // the board must outlive the server's last use of it
   }
   std::printf("\npty round trip, %d pings each, two interleaved rounds:\n", 2 * n);
   std::printf("  raw pty echo (floor)        %7.2f us\n", echo_us);

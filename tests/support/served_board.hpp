@@ -5,22 +5,13 @@
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 
-#include <future>
-
 namespace rcb4::testing {
 
 struct served_board {
   explicit served_board(transport::serve_options so = {}, board::options bo = {}) : board(bo) {
     server = transport::board_server::serve_pty(server_io.context(), board, std::move(so));
   }
-  ~served_board() {
-    std::promise<void> done;
-    boost::asio::post(server_io.context(), [&] {
-      server->stop();
-      done.set_value();
-    });
-    done.get_future().wait();
-  }
+  ~served_board() { transport::board_server::shutdown(server); }
   served_board(const served_board&) = delete;
   served_board& operator=(const served_board&) = delete;
 

@@ -14,6 +14,7 @@
 
 #include <chrono>
 #include <functional>
+#include <future>
 #include <memory>
 #include <string>
 #include <vector>
@@ -74,6 +75,26 @@ class board_server : public std::enable_shared_from_this<board_server> {
 
   /** Where clients connect: the pty path or "HOST:PORT". */
   const std::string& where() const noexcept { return where_; }
+  /**
+   * Stops @p s and waits until it has, then releases the pointer, so that the server goes away
+   * while its io_context still lives. From another thread, the io_context must be running (the
+   * stop runs there); on the io_context's own thread it stops at once.
+   */
+  static void shutdown(std::shared_ptr<board_server>& s) {
+    if (!s) return;
+    if (s->io_.get_executor().running_in_this_thread()) {
+      s->stop();
+    } else {
+      std::promise<void> stopped;
+      boost::asio::post(s->io_, [&] {
+        s->stop();
+        stopped.set_value();
+      });
+      stopped.get_future().wait();
+    }
+    s.reset();
+  }
+
   /** Stops serving (pending operations end; the io_context can then run out). */
   void stop() {
     stopped_ = true;
