@@ -13,13 +13,7 @@ import time
 import tty
 
 RCB4 = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
+from checks import check, finish
 
 
 def run(*args, stdin=None, timeout=60):
@@ -204,5 +198,4 @@ rc, out, err = run("--device", silent.path, "--timeout", "20", "ping")
 check(rc == 4 and "no RCB-4 answered" in err, f"silent board, baud detection: exit 4 (rc {rc}: {err[:120]!r})")
 expect_rc(["--device", "/dev/does-not-exist", "--baud", "115200", "ping"], 3, "no such device")
 
-print(f"\n{len(failures)} failure(s)")
-sys.exit(1 if failures else 0)
+finish()

@@ -15,13 +15,7 @@ import termios
 import time
 
 RCB4 = sys.argv[1]
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
+from checks import check, finish
 
 
 def frame(*b):
@@ -198,10 +192,7 @@ def main():
     bad = subprocess.run([RCB4, "serve"], capture_output=True, text=True)
     check(bad.returncode == 2 and "--pty or --tcp" in bad.stderr, "serve: no transport named is a usage error")
 
-    if failures:
-        print(f"\n{len(failures)} checks failed")
-        sys.exit(1)
-    print("all checks passed")
+    finish()
 
 
 main()
