@@ -66,6 +66,26 @@ TEST_CASE("client: sync execute against the virtual board", "[transport]") {
   CHECK(c.counters().exchanges == 6);
 }
 
+TEST_CASE("client: a blocking call on an idle line does its I/O on the caller's thread", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  t::client_options opt;
+  std::thread::id io_id;
+  opt.trace = [&io_id](t::direction, std::chrono::steady_clock::time_point, std::span<const std::uint8_t>) {
+    io_id = std::this_thread::get_id();
+  };
+  opt.direct_io = GENERATE(true, false);
+  auto c = open_client(io, b.server->where(), opt);
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  CHECK((io_id == std::this_thread::get_id()) == opt.direct_io);
+  // The async API always runs on the executor's thread.
+  c.async_execute(ping{}, boost::asio::use_future).get();
+  CHECK(io_id != std::this_thread::get_id());
+  CHECK(c.counters().exchanges == 2);
+  CHECK(c.counters().bytes_out == 8);
+  CHECK(c.counters().bytes_in == 8);
+}
+
 TEST_CASE("client: callback, future, coroutine and deferred completions", "[transport]") {
   served_board b;
   t::io_thread io;
@@ -98,6 +118,8 @@ TEST_CASE("client: a silent board times out within the deadline", "[transport]")
   t::io_thread io;
   t::client_options opt;
   opt.turnaround = 20ms;
+  opt.direct_io = GENERATE(true, false);  // the caller's thread does the first attempt, or the executor's
+  INFO("direct_io " << opt.direct_io);
   auto c = open_client(io, silent.path(), opt);
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
@@ -130,6 +152,8 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
   t::client_options opt;
   opt.turnaround = 20ms;
   opt.read_retries = 0;
+  opt.direct_io = GENERATE(true, false);
+  INFO("direct_io " << opt.direct_io);
   auto c = open_client(io, b.server->where(), opt);
   const auto read = move::read_ram(ram::pio_direction, 2).value();
   for (int m : {1, 2, 3, 5}) {
@@ -207,11 +231,21 @@ TEST_CASE("client: 8 threads, every reply reaches its caller", "[transport][thre
       for (int i = 0; i < per_thread; ++i) {
         const std::uint16_t v = static_cast<std::uint16_t>(k * 4096 + i);
         const std::uint8_t bytes[] = {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
+        // Even threads block (their exchanges run on their own thread when the line is idle);
+        // odd threads use the async API (queued for the executor's worker): the two interleave.
+        const auto exchange = [&](const command& cmd, std::error_code& ec) {
+          if (k % 2 == 0) return c.execute(cmd, ec);
+          std::promise<std::pair<std::error_code, t::response>> done;
+          c.async_execute(cmd, [&done](boost::system::error_code e, t::response r) { done.set_value({e, r}); });
+          auto [e, r] = done.get_future().get();
+          ec = e;
+          return r;
+        };
         std::error_code ec;
         if (i % 2 == 0) {
-          c.execute(move::write_ram(addr, bytes).value(), ec);
+          exchange(move::write_ram(addr, bytes).value(), ec);
         } else {
-          const auto r = c.execute(move::read_ram(addr, 2).value(), ec);
+          const auto r = exchange(move::read_ram(addr, 2).value(), ec);
           if (!ec && r.u16() != static_cast<std::uint16_t>(v - 1)) ++wrong;
         }
         if (ec) ++failed;
@@ -279,8 +313,13 @@ TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[
     CHECK(c.execute(move::read_ram(ram::config, 2).value()).u16() == board::default_config);
     CHECK(t::run(c, ops::read_analog{}).battery_volts == Approx(10.8).margin(0.1));
   }
-  std::system(("kill $(cat " + dir + "/child) 2>/dev/null").c_str());
-  std::filesystem::remove_all(dir);
+  // Stop ser2net and wait (bounded) until it has gone: it removes its pid file on the way out.
+  std::system(("p=$(cat " + dir +
+               "/child); kill $p 2>/dev/null; for i in $(seq 100); do kill -0 $p 2>/dev/null || break; " +
+               "sleep 0.02; done")
+                  .c_str());
+  std::error_code rm;
+  std::filesystem::remove_all(dir, rm);
 }
 
 TEST_CASE("client: operations run on the client, baud detection, bad addresses", "[transport]") {

@@ -7,8 +7,10 @@
 //   c.async_execute(rcb4::ping{}, [](boost::system::error_code ec, rcb4::transport::response r) { ... });
 //   auto r2 = co_await c.async_execute(cmd, boost::asio::use_awaitable);
 //
-// Requests from any thread queue FIFO on a strand; one exchange is on the line at a time, so the
-// bytes of two exchanges never interleave and no caller ever sees "busy". Each exchange has a
+// Requests from any thread queue FIFO; one exchange is on the line at a time, so the bytes of two
+// exchanges never interleave and no caller ever sees "busy". A worker coroutine on a strand of
+// the stream's executor works through the queue; a blocking call that finds the line idle does
+// its exchange on its own thread instead (no hand-off; client_options::direct_io). Each exchange has a
 // deadline computed from the wire (11 bits per byte at the configured baud) plus a turnaround
 // allowance. After a timeout, a bad frame or stray bytes, the next exchange first drains the line
 // until it has been quiet for a while. Idempotent reads are retried by policy.
@@ -17,6 +19,7 @@
 #include <rcb4/rcb4.hpp>
 #include <rcb4/transport/concepts.hpp>
 #include <rcb4/transport/detail/exchange.hpp>
+#include <rcb4/transport/detail/fifo.hpp>
 #include <rcb4/transport/error.hpp>
 
 #include <boost/asio/any_completion_handler.hpp>
@@ -33,13 +36,16 @@
 #include <boost/asio/use_awaitable.hpp>
 #include <boost/asio/write.hpp>
 
+#include <fcntl.h>
+#include <poll.h>
 #include <sys/ioctl.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <deque>
 #include <functional>
 #include <future>
 #include <mutex>
@@ -78,7 +84,12 @@ struct client_options {
   std::chrono::milliseconds quiet{5};         ///< silence that ends a drain after an error
   unsigned read_retries = 2;                  ///< extra attempts for idempotent reads (ping, VERSION, MOV → COM)
   bool retry_writes = false;  ///< also retry commands that change the board (only if you know they are safe)
-  /** Called with every frame on the line (direction, monotonic time, bytes). */
+  /**
+   * Blocking calls on an idle line do their I/O on the calling thread (streams with a
+   * descriptor); false sends every exchange through the executor's thread.
+   */
+  bool direct_io = true;
+  /** Called with every frame on the line (direction, monotonic time, bytes), on the thread doing the I/O. */
   std::function<void(direction, std::chrono::steady_clock::time_point, std::span<const std::uint8_t>)> trace;
 };
 
@@ -150,19 +161,19 @@ class basic_client {
   /**
    * Closes the stream. If an exchange is still in flight and this is not the executor's thread,
    * waits until the worker has left (it ends quickly: the close cancels its I/O). Requests still
-   * queued then fail with errc::cancelled.
+   * queued then fail with errc::cancelled. No blocking execute() may be running in another thread.
    */
   ~basic_client() {
     if (running_here()) return;  // the executor's own thread: nothing can be in flight concurrently
     std::promise<void> idle;
     auto done = idle.get_future();
     boost::asio::dispatch(strand_, [this, &idle] {
+      std::lock_guard lock(m_);
       closing_ = true;
       boost::system::error_code ignored;
       stream_.close(ignored);
       timer_.cancel();
-      for (auto& p : queue_) complete(std::move(p.handler), errc::cancelled, response{});
-      queue_.clear();
+      while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
       if (busy_)
         idle_ = &idle;
       else
@@ -178,45 +189,45 @@ class basic_client {
   template <class Token = boost::asio::default_completion_token_t<executor_type>>
   auto async_execute(const command& c, Token&& token = {}) {
     return boost::asio::async_initiate<Token, signature>(
-        [this](auto handler, request r) {
-          boost::asio::dispatch(strand_, [this, r, h = std::move(handler)]() mutable {
-            queue_.push_back(pending{r, handler_type(std::move(h))});
-            if (!busy_) {
-              busy_ = true;
-              boost::asio::co_spawn(strand_, run(), boost::asio::detached);
-            }
-          });
+        [this](auto handler, const request& r) {
+          enqueue(pending{r, handler_type(std::move(handler)), 0});
         },
         token, request{encode(c), expected_reply(c), is_idempotent(c)});
   }
 
   /**
-   * Blocking: sends @p c and waits for its reply or its deadline. The client's executor must be
-   * run by another thread (see io_thread); from that thread it fails with errc::would_deadlock.
+   * Blocking: sends @p c and waits for its reply or its deadline. When the line is idle and the
+   * stream has a descriptor (serial port, pty, socket), the exchange runs on the calling thread
+   * (client_options::direct_io), with no hand-off to the executor; otherwise, and for any retry
+   * after an error, it queues behind the others and the executor's thread runs it. Either way the
+   * executor must be run by another thread (see io_thread): from that thread this fails with
+   * errc::would_deadlock.
    */
   response execute(const command& c, std::error_code& ec) {
     if (running_here()) {
       ec = errc::would_deadlock;
       return {};
     }
-    struct slot {
-      std::error_code ec;
-      response r;
-      bool done = false;
-      std::mutex m;
-      std::condition_variable cv;
-    } s;  // on this stack: no shared state to allocate
-    async_execute(c, [&s](boost::system::error_code e, response r) {
-      std::lock_guard lock(s.m);  // notify under the lock: the waiter cannot leave (and free s) before unlock
-      s.ec = e;
-      s.r = r;
-      s.done = true;
-      s.cv.notify_one();
-    });
-    std::unique_lock lock(s.m);
-    s.cv.wait(lock, [&s] { return s.done; });
-    ec = s.ec;
-    return s.r;
+    const request req{encode(c), expected_reply(c), is_idempotent(c)};
+    if constexpr (has_descriptor) {
+      if (opt_.direct_io && claim_idle_line()) {
+        if (bytes_waiting() > 0) {  // stray bytes (a late or duplicated reply): the worker resyncs first
+          dirty_ = true;
+          return wait_for(req, 0, true, ec);
+        }
+        response out;
+        std::error_code e;
+        detail::exchange ex(req.frame.bytes(), req.shape);
+        const bool again = judge(direct_attempt(ex, req), e, out);
+        if (!again || attempts(req) == 1) {
+          release_line(e);
+          ec = e;
+          return out;
+        }
+        return wait_for(req, 1, true, ec);  // the worker retries: it resynchronises the line first
+      }
+    }
+    return wait_for(req, 0, false, ec);
   }
   /** Blocking; throws std::system_error on any error (a NACK included). */
   response execute(const command& c) {
@@ -249,13 +260,28 @@ class basic_client {
   struct request {
     request_frame frame;
     reply_shape shape;
-    bool idempotent;
+    bool idempotent = false;
   };
   using handler_type = boost::asio::any_completion_handler<signature>;
   struct pending {
     request req;
     handler_type handler;
+    unsigned attempts_done = 0;  ///< attempts already made by the caller's thread
   };
+  /** How one attempt on the line ended (before judging it). */
+  struct attempt_result {
+    std::error_code line;    ///< the stream failed (read, write, end of file)
+    bool timed_out = false;  ///< the deadline passed first
+    const detail::exchange* ex = nullptr;
+  };
+  using clock = std::chrono::steady_clock;
+
+  /** Streams with a descriptor: blocking calls can do their I/O on the caller's thread. */
+  static constexpr bool has_descriptor = requires(Stream & s) {
+    { s.native_handle() } -> std::convertible_to<int>;
+  };
+  /** Sockets are written with send(MSG_NOSIGNAL): a closed peer is an error, not SIGPIPE. */
+  static constexpr bool is_socket = requires(Stream & s) { s.remote_endpoint(); };
 
   bool running_here() const {
     if constexpr (requires { stream_.get_executor().running_in_this_thread(); })
@@ -264,14 +290,106 @@ class basic_client {
       return false;
   }
 
+  unsigned attempts(const request& r) const noexcept {
+    return 1 + ((r.idempotent || opt_.retry_writes) ? opt_.read_retries : 0);
+  }
+
+  // --- the queue: any thread may add; one worker at a time (busy_) owns the line ----------------
+
+  /**
+   * Queues @p p and starts the worker if the line is free. With @p holding_line the calling
+   * thread owns the line (a caller-thread attempt failed): @p p goes first and the worker
+   * takes the line over.
+   */
+  void enqueue(pending p, bool holding_line = false) {
+    bool start = false;
+    {
+      std::lock_guard lock(m_);
+      if (closing_) {
+        complete(std::move(p.handler), errc::cancelled, response{});
+      } else if (holding_line) {
+        queue_.push_front(std::move(p));
+      } else {
+        queue_.push_back(std::move(p));
+        start = !busy_;
+        busy_ = true;
+      }
+    }
+    if (holding_line)
+      hand_over_line();
+    else if (start)
+      boost::asio::co_spawn(strand_, run(), boost::asio::detached);  // never under m_: it may start inline
+  }
+
+  /** Takes the line for the calling thread if nothing runs or waits and it needs no resync. */
+  bool claim_idle_line() {
+    std::lock_guard lock(m_);
+    if (busy_ || closing_ || dirty_ || lost_) return false;  // (dirty_/lost_ are read only while idle)
+    if constexpr (requires { stream_.is_open(); })
+      if (!stream_.is_open()) return false;  // the worker reports (or reopens) it
+    busy_ = true;
+    return true;
+  }
+
+  /** Ends a caller-thread exchange: counts it, then hands the line to the queue, if any waits. */
+  void release_line(const std::error_code& ec) {
+    ++counters_.exchanges;
+    if (ec) ++counters_.errors;
+    hand_over_line();
+  }
+
+  /** The owner of the line lets it go: to a new worker if requests wait, else it is idle. */
+  void hand_over_line() {
+    std::promise<void>* idle = nullptr;
+    bool start = false;
+    {
+      std::lock_guard lock(m_);
+      if (queue_.empty() || closing_) {
+        busy_ = false;
+        idle = idle_;
+      } else {
+        start = true;  // busy_ passes to the worker
+      }
+    }
+    if (start)
+      boost::asio::co_spawn(strand_, run(), boost::asio::detached);
+    else if (idle)
+      idle->set_value();  // the last touch of `this`: a destructor is waiting
+  }
+
+  /**
+   * Queues @p req, with @p done attempts already made, and blocks until it completes. With
+   * @p holding_line this thread owns the line and @p req goes first. The result waits in a slot
+   * on this stack: nothing shared to allocate.
+   */
+  response wait_for(const request& req, unsigned done, bool holding_line, std::error_code& ec) {
+    struct slot {
+      std::error_code ec;
+      response r;
+      bool done = false;
+      std::mutex m;
+      std::condition_variable cv;
+    } s;
+    auto h = [&s](boost::system::error_code e, response r) {
+      std::lock_guard lock(s.m);  // notify under the lock: the waiter cannot leave (and free s) before unlock
+      s.ec = e;
+      s.r = r;
+      s.done = true;
+      s.cv.notify_one();
+    };
+    enqueue(pending{req, handler_type(std::move(h)), done}, holding_line);
+    std::unique_lock lock(s.m);
+    s.cv.wait(lock, [&s] { return s.done; });
+    ec = s.ec;
+    return s.r;
+  }
+
   /** Bytes already waiting on the line (0 when the stream cannot tell). */
   std::size_t bytes_waiting() {
     if constexpr (requires(boost::system::error_code & e) { stream_.available(e); }) {
       boost::system::error_code e;
       return stream_.available(e);
-    } else if constexpr (requires {
-                           { stream_.native_handle() } -> std::convertible_to<int>;
-                         }) {
+    } else if constexpr (has_descriptor) {
       int n = 0;  // serial ports and descriptors: ask the driver
       return ::ioctl(stream_.native_handle(), FIONREAD, &n) == 0 && n > 0 ? static_cast<std::size_t>(n) : 0;
     } else {
@@ -279,33 +397,151 @@ class basic_client {
     }
   }
 
-  std::chrono::steady_clock::duration budget(const request& r) const {
+  clock::duration budget(const request& r) const {
     const auto bytes = r.frame.size() + r.shape.frame_size();
     return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / opt_.baud) +
            opt_.turnaround;
   }
 
   void trace(direction d, std::span<const std::uint8_t> b) {
-    if (opt_.trace && !b.empty()) opt_.trace(d, std::chrono::steady_clock::now(), b);
+    if (opt_.trace && !b.empty()) opt_.trace(d, clock::now(), b);
   }
+
+  /**
+   * The bookkeeping after one attempt, shared by both drivers. Fills @p out and sets @p ec to
+   * the exchange's outcome; returns true when another attempt may help (a timeout, a bad frame,
+   * a lost link that can be reopened), false when @p ec is final. Marks the line for a resync
+   * after any error.
+   */
+  bool judge(const attempt_result& a, std::error_code& ec, response& out) {
+    if (a.line) {
+      dirty_ = true;
+      ec = a.line;
+      if (!is_link_lost(ec)) return false;
+      lost_ = true;
+      return reopen_ && !closing_;  // a retriable read tries again on a new link
+    }
+    if (a.timed_out) {
+      ++counters_.timeouts;
+      dirty_ = true;
+      ec = errc::timeout;
+      return true;
+    }
+    const auto& r = a.ex->result();
+    if (r.status == parse_status::error) {
+      dirty_ = true;  // stray or corrupted bytes: resync before the next exchange
+      ec = r.error;
+      return true;
+    }
+    out.kind = r.value.kind();
+    out.command = r.value.command();
+    out.data = byte_buffer<max_reply_data>(r.value.bytes());
+    ec = out.kind == reply_kind::nack ? std::error_code(rcb4::errc::nack) : std::error_code{};
+    return false;
+  }
+
+  // --- the caller-thread driver: the exchange machine on the descriptor, ppoll for deadlines ------
+
+  /** Waits until @p fd is ready for @p events; false when @p deadline passes first. */
+  static bool ready_before(int fd, short events, clock::time_point deadline, std::error_code& ec) {
+    for (;;) {
+      const auto left = std::chrono::duration_cast<std::chrono::nanoseconds>(deadline - clock::now()).count();
+      if (left <= 0) return false;
+      const timespec ts{static_cast<time_t>(left / 1'000'000'000), static_cast<long>(left % 1'000'000'000)};
+      pollfd p{fd, events, 0};
+      const int r = ::ppoll(&p, 1, &ts, nullptr);
+      if (r > 0) {
+        if (p.revents & POLLNVAL) ec = std::error_code(EBADF, std::generic_category());
+        return true;  // readable, writable, or an error/hang-up that the read or write reports
+      }
+      if (r < 0 && errno != EINTR) {
+        ec = std::error_code(errno, std::generic_category());
+        return true;
+      }
+    }
+  }
+
+  /** One attempt of @p req on this thread, driving @p ex (the caller holds the line). */
+  attempt_result direct_attempt(detail::exchange& ex, const request& req) {
+    const int fd = stream_.native_handle();
+    if (fd != nonblocking_fd_) {  // once per descriptor: every wait is a ppoll with a deadline
+      const int flags = ::fcntl(fd, F_GETFL);
+      if (flags >= 0 && (flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, flags | O_NONBLOCK);
+      nonblocking_fd_ = fd;
+    }
+    attempt_result a{{}, false, &ex};
+    const auto deadline = clock::now() + budget(req);
+    trace(direction::tx, req.frame.bytes());
+    while (ex.next() != detail::exchange::step::done) {
+      const bool writing = ex.next() == detail::exchange::step::write;
+      if (!writing && !ready_before(fd, POLLIN, deadline, a.line)) {  // a reply is never there yet
+        a.timed_out = true;
+        break;
+      }
+      if (a.line) break;
+      ssize_t n;
+      if (writing) {
+        const auto w = ex.to_write();
+        if constexpr (is_socket)
+          n = ::send(fd, w.data(), w.size(), MSG_NOSIGNAL);
+        else
+          n = ::write(fd, w.data(), w.size());
+      } else {
+        const auto buf = ex.read_buffer();
+        n = ::read(fd, buf.data(), buf.size());
+      }
+      if (n > 0) {
+        const auto k = static_cast<std::size_t>(n);
+        if (writing) {
+          counters_.bytes_out += k;
+          ex.wrote(k);
+        } else {
+          counters_.bytes_in += k;
+          trace(direction::rx, ex.read_buffer().first(k));
+          ex.received(k);
+        }
+      } else if (n == 0 && !writing) {
+        a.line = errc::closed;  // end of file: the other side has gone
+        break;
+      } else if (n == 0 || errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR) {
+        if (writing && !ready_before(fd, POLLOUT, deadline, a.line)) {
+          a.timed_out = true;
+          break;
+        }
+        if (a.line) break;
+      } else {
+        a.line = std::error_code(errno, std::generic_category());
+        break;
+      }
+    }
+    return a;
+  }
+
+  // --- the executor's driver: one coroutine works through the queue -----------------------------
 
   boost::asio::awaitable<void> run() {
     for (;;) {
-      pending p = std::move(queue_.front());
-      queue_.pop_front();
+      pending p = [this] {
+        std::lock_guard lock(m_);
+        return queue_.pop_front();
+      }();
       response r;
-      const std::error_code ec = co_await perform(p.req, r);
+      const std::error_code ec = co_await perform(p.req, r, p.attempts_done);
       ++counters_.exchanges;
       if (ec) ++counters_.errors;
-      const bool more = !queue_.empty() && !closing_;
       // The completion runs on the strand only after this coroutine suspends or returns, so the
-      // caller cannot see it before finish_worker(); finish_worker() is the last touch of `this`
-      // (a destructor may be waiting for it).
+      // caller cannot see it before the line is released; releasing it is the last touch of
+      // `this` (a destructor may be waiting for it).
       complete(std::move(p.handler), ec, r);
-      if (!more) {
-        finish_worker();
-        co_return;
+      std::promise<void>* idle = nullptr;
+      {
+        std::lock_guard lock(m_);
+        if (!queue_.empty() && !closing_) continue;
+        busy_ = false;
+        idle = idle_;
       }
+      if (idle) idle->set_value();
+      co_return;
     }
   }
 
@@ -321,13 +557,8 @@ class basic_client {
     });
   }
 
-  void finish_worker() {
-    busy_ = false;
-    if (idle_) idle_->set_value();
-  }
-
   /** Starts the exchange's deadline: when it expires, the pending read or write is cancelled. */
-  void arm(std::chrono::steady_clock::duration d) {
+  void arm(clock::duration d) {
     timed_out_ = false;
     const auto gen = ++generation_;
     timer_.expires_after(d);
@@ -412,19 +643,20 @@ class basic_client {
 
   /** Reopens the link with backoff until policy_.give_up_after. */
   boost::asio::awaitable<std::error_code> reconnect() {
-    const auto give_up = std::chrono::steady_clock::now() + policy_.give_up_after;
+    const auto give_up = clock::now() + policy_.give_up_after;
     auto delay = policy_.first_delay;
     for (;;) {
       if (closing_) co_return errc::cancelled;
       std::error_code e;
       reopen_(stream_, e);
+      nonblocking_fd_ = -1;  // a new descriptor (possibly with the old number)
       if (!e) {
         lost_ = false;
         dirty_ = false;
         ++counters_.reconnects;
         co_return std::error_code{};
       }
-      const auto now = std::chrono::steady_clock::now();
+      const auto now = clock::now();
       if (now >= give_up) co_return errc::reconnect_failed;
       timer_.expires_at(std::min(give_up, now + delay));
       co_await timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable));
@@ -432,10 +664,10 @@ class basic_client {
     }
   }
 
-  boost::asio::awaitable<std::error_code> perform(const request& req, response& out) {
-    const unsigned attempts = 1 + ((req.idempotent || opt_.retry_writes) ? opt_.read_retries : 0);
-    std::error_code ec;
-    for (unsigned attempt = 0; attempt < attempts; ++attempt) {
+  /** Runs @p req's remaining attempts (after @p first made elsewhere). */
+  boost::asio::awaitable<std::error_code> perform(const request& req, response& out, unsigned first) {
+    std::error_code ec = first > 0 ? std::error_code(errc::timeout) : std::error_code{};
+    for (unsigned attempt = first; attempt < attempts(req); ++attempt) {
       if (attempt > 0) ++counters_.retries;
       if (lost_ && reopen_) {
         ec = co_await reconnect();
@@ -453,51 +685,29 @@ class basic_client {
           co_return ec;
         }
       }
-      ec.clear();  // this attempt's own outcome
       detail::exchange ex(req.frame.bytes(), req.shape);
+      attempt_result a{{}, false, &ex};
       trace(direction::tx, req.frame.bytes());
       arm(budget(req));
-      while (ex.next() != detail::exchange::step::done && !ec && !timed_out_) {
+      while (ex.next() != detail::exchange::step::done && !a.line && !timed_out_) {
         if (ex.next() == detail::exchange::step::write) {
           const auto w = ex.to_write();
           auto [e, n] = co_await boost::asio::async_write(stream_, boost::asio::buffer(w.data(), w.size()), token());
           counters_.bytes_out += n;
           ex.wrote(n);
-          if (e && !timed_out_) ec = line_error(e);
+          if (e && !timed_out_) a.line = line_error(e);
         } else {
           const auto buf = ex.read_buffer();
           auto [e, n] = co_await stream_.async_read_some(boost::asio::buffer(buf.data(), buf.size()), token());
           counters_.bytes_in += n;
           trace(direction::rx, buf.first(n));
           if (n > 0) ex.received(n);
-          if (e && !timed_out_) ec = line_error(e);
+          if (e && !timed_out_) a.line = line_error(e);
         }
       }
       disarm();
-      if (ec) {
-        dirty_ = true;
-        if (is_link_lost(ec)) {
-          lost_ = true;
-          if (reopen_ && !closing_) continue;  // a retriable read tries again on a new link
-        }
-        co_return ec;  // the line itself failed
-      }
-      if (timed_out_) {
-        ++counters_.timeouts;
-        dirty_ = true;
-        ec = errc::timeout;
-        continue;
-      }
-      const auto& r = ex.result();
-      if (r.status == parse_status::error) {
-        dirty_ = true;  // stray or corrupted bytes: resync before the next exchange
-        ec = r.error;
-        continue;
-      }
-      out.kind = r.value.kind();
-      out.command = r.value.command();
-      out.data = byte_buffer<max_reply_data>(r.value.bytes());
-      co_return out.kind == reply_kind::nack ? std::error_code(rcb4::errc::nack) : std::error_code{};
+      a.timed_out = timed_out_ && !a.line;
+      if (!judge(a, ec, out)) co_return ec;
     }
     co_return ec;
   }
@@ -506,17 +716,20 @@ class basic_client {
   client_options opt_;
   boost::asio::strand<executor_type> strand_;
   boost::asio::steady_timer timer_;
-  std::deque<pending> queue_;
-  bool busy_ = false;
-  bool dirty_ = false;
+  std::mutex m_;                 // guards queue_, busy_, closing_, idle_
+  detail::fifo<pending> queue_;  // requests waiting for the line
+  bool busy_ = false;            // a worker or a calling thread owns the line
   bool closing_ = false;
-  bool timed_out_ = false;
+  std::promise<void>* idle_ = nullptr;
+  // The line's state: touched only by whoever owns the line (busy_ hands it over under m_).
+  bool dirty_ = false;
   bool lost_ = false;
+  bool timed_out_ = false;
+  int nonblocking_fd_ = -1;
   std::function<void(Stream&, std::error_code&)> reopen_;
   reconnect_policy policy_;
   std::uint64_t generation_ = 0;
   boost::asio::cancellation_signal cancel_;
-  std::promise<void>* idle_ = nullptr;
   client_counters counters_;
 };
 
