@@ -3,6 +3,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <rcb4/ops.hpp>
 #include <rcb4/transport/pty.hpp>
 
 #include <boost/asio.hpp>
@@ -37,6 +38,44 @@ inline double pty_round_trips(const std::string& path, std::span<const std::uint
   const auto us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   ::close(fd);
   return us / n;
+}
+
+/**
+ * A control cycle by a bare blocking loop on @p path: ops::read_servo_states (planned for
+ * @p cost) then @p write, @p n times; µs per cycle. Each exchange writes its frame and reads
+ * exactly its reply's length: the least any client can spend on this line.
+ */
+inline double raw_cycle_us(const std::string& path, ops::link_cost cost, const command& write, int n) {
+  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
+  termios t{};
+  ::tcgetattr(fd, &t);
+  ::cfmakeraw(&t);
+  ::tcsetattr(fd, TCSANOW, &t);
+  std::array<std::uint8_t, max_reply_size> buf{};
+  bool ok = true;
+  const auto exchange = [&](const command& c) {
+    const auto frame = encode(c);
+    const auto shape = expected_reply(c);
+    ok = ok && ::write(fd, frame.bytes().data(), frame.size()) == static_cast<ssize_t>(frame.size());
+    std::size_t got = 0;
+    while (ok && got < shape.frame_size()) {
+      const auto r = ::read(fd, buf.data() + got, shape.frame_size() - got);
+      ok = r > 0;
+      got += ok ? static_cast<std::size_t>(r) : 0;
+    }
+    const auto parsed = parse_reply(std::span(buf).first(got), shape);
+    ok = ok && parsed.status == parse_status::complete;
+    return parsed.value;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < n && ok; ++i) {
+    ops::read_servo_states op(cost);
+    while (auto c = op.next()) op.on_reply(exchange(*c));
+    exchange(write);
+  }
+  const auto us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
+  ::close(fd);
+  return ok ? us / n : -1.0;
 }
 
 /** Echoes every byte back on a new pty, on @p io (run by another thread): the floor any pty server can reach. */

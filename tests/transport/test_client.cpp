@@ -86,6 +86,22 @@ TEST_CASE("client: a blocking call on an idle line does its I/O on the caller's 
   CHECK(c.counters().bytes_in == 8);
 }
 
+TEST_CASE("board_server: a paced reply never comes before the wire would have carried it", "[transport][pace]") {
+  t::serve_options so;
+  so.pace = true;
+  served_board b(so);
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  const auto read = move::read_ram(0x0400, 128).value();  // 10 bytes out, 131 back
+  const auto wire = t::wire_time(10 + 131, 1250000);      // the board's boot rate
+  for (int i = 0; i < 20; ++i) {
+    c.options().busy_poll = i % 2 ? 200us : 0us;  // the client's wait, sleeping or polling, changes nothing here
+    const auto start = std::chrono::steady_clock::now();
+    CHECK(c.execute(read).data.size() == 128);
+    CHECK(std::chrono::steady_clock::now() - start >= wire);  // a lower bound the pacer guarantees
+  }
+}
+
 TEST_CASE("client: callback, future, coroutine and deferred completions", "[transport]") {
   served_board b;
   t::io_thread io;
@@ -119,7 +135,8 @@ TEST_CASE("client: a silent board times out within the deadline", "[transport]")
   t::client_options opt;
   opt.turnaround = 20ms;
   opt.direct_io = GENERATE(true, false);  // the caller's thread does the first attempt, or the executor's
-  INFO("direct_io " << opt.direct_io);
+  opt.busy_poll = GENERATE(0us, 300us);   // a busy-polling wait still ends at the deadline
+  INFO("direct_io " << opt.direct_io << ", busy_poll " << opt.busy_poll.count() << " us");
   auto c = open_client(io, silent.path(), opt);
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;

@@ -4,7 +4,10 @@
 // One io_context thread owns the board: a reader loop feeds it the bytes of the current
 // connection and writes its replies; a tick loop advances its clock every output period so
 // motions play while nobody talks. Optional pacing delays each reply by the wire time of the
-// request and the reply (11 bits per byte at the board's current COM rate) plus a latency.
+// request and the reply (11 bits per byte at the board's current COM rate) plus a latency,
+// counted from the request's arrival. The pacer never writes before that time; it learns how
+// late its timer wakes (timer slack, scheduling) and aims that much earlier, so that replies
+// leave on time rather than some tens of µs after it.
 #pragma once
 
 #include <rcb4/board/virtual_board.hpp>
@@ -12,6 +15,7 @@
 
 #include <boost/asio.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <future>
@@ -135,18 +139,24 @@ class board_server : public std::enable_shared_from_this<board_server> {
       const std::size_t n = co_await stream.async_read_some(
           boost::asio::buffer(buf), boost::asio::redirect_error(boost::asio::use_awaitable, ec));
       if (ec) co_return;
+      const auto arrived = clock::now();
       out.clear();
       const std::uint32_t baud = board_.line_baud();  // the rate the request travelled at
       board_.receive(std::span(buf).first(n), now(), out);
       if (opt_.tamper) opt_.tamper(out);
       if (out.empty()) continue;
       if (opt_.pace || opt_.latency.count() > 0) {
-        auto delay = opt_.latency;
-        if (opt_.pace)
-          delay +=
-              std::chrono::duration_cast<std::chrono::microseconds>(wire_time(n, baud) + wire_time(out.size(), baud));
-        pacer.expires_after(delay);
+        // The reply is due when the wire would have carried the request and the reply. The
+        // timer wakes this thread late by some tens of µs (timer slack, wake-up); the pacer
+        // learns by how much on average and aims that much earlier, so replies leave on time.
+        const auto due = arrived + opt_.latency +
+                         (opt_.pace ? wire_time(n, baud) + wire_time(out.size(), baud) : std::chrono::nanoseconds{0});
+        pacer.expires_at(due - wake_lateness_);
         co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+        while (clock::now() < due) {  // woke early by a few µs: never before the wire allows
+        }
+        const auto late = clock::now() - (due - wake_lateness_);  // this wake-up's own lateness
+        wake_lateness_ += (std::clamp(late, clock::duration{0}, max_lateness) - wake_lateness_) / 8;
       }
       std::size_t sent = 0;
       if (opt_.pieces)
@@ -196,6 +206,8 @@ class board_server : public std::enable_shared_from_this<board_server> {
   std::optional<boost::asio::ip::tcp::socket> tcp_stream_;
   std::string where_;
   bool stopped_ = false;
+  clock::duration wake_lateness_{0};  // how late the pacer's timer fires, on average
+  static constexpr clock::duration max_lateness = std::chrono::milliseconds(1);
 };
 
 }  // namespace rcb4::transport
