@@ -13,7 +13,7 @@
 using namespace rcb4;
 namespace asio = boost::asio;
 
-asio::awaitable<void> robot(transport::basic_client<asio::serial_port>& c) {
+asio::awaitable<void> robot(transport::basic_client<transport::serial_port>& c) {
   co_await c.async_execute(ping{}, asio::use_awaitable);
   const auto v = co_await transport::async_run(c, ops::read_version{});
   std::printf("connected: %s\n", v.c_str());

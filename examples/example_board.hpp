@@ -21,7 +21,7 @@ struct connection {
   std::unique_ptr<rcb4::transport::io_thread> board_io;
   std::shared_ptr<rcb4::transport::board_server> server;
   rcb4::transport::io_thread io;
-  std::unique_ptr<rcb4::transport::basic_client<boost::asio::serial_port>> client;
+  std::unique_ptr<rcb4::transport::basic_client<rcb4::transport::serial_port>> client;
 
   /** argv[1] is the device (e.g. /dev/ttyUSB0); none: the virtual board. */
   connection(int argc, char** argv) {
@@ -38,7 +38,7 @@ struct connection {
     if (ec) throw std::system_error(ec, path);
     rcb4::transport::client_options opt;
     opt.baud = baud;
-    client = std::make_unique<rcb4::transport::basic_client<boost::asio::serial_port>>(
+    client = std::make_unique<rcb4::transport::basic_client<rcb4::transport::serial_port>>(
         rcb4::transport::open_serial(io.context(), path, baud), opt);
   }
   ~connection() {
@@ -49,7 +49,7 @@ struct connection {
   connection& operator=(const connection&) = delete;
 
   /** The client. */
-  rcb4::transport::basic_client<boost::asio::serial_port>& operator*() { return *client; }
+  rcb4::transport::basic_client<rcb4::transport::serial_port>& operator*() { return *client; }
 };
 
 }  // namespace example

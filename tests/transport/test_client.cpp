@@ -317,7 +317,7 @@ TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[
   REQUIRE(std::system(cmd.c_str()) == 0);
   t::io_thread io;
   std::error_code ec;
-  boost::asio::ip::tcp::socket s(io.context());
+  t::tcp_socket s(io.context());
   for (int i = 0; i < 100; ++i) {  // ser2net needs a moment to listen; bounded
     s = t::connect(io.context(), "127.0.0.1:" + std::to_string(port), ec);
     if (!ec) break;

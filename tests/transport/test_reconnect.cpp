@@ -93,8 +93,7 @@ TEST_CASE("reconnect: a pty whose board went away, then came back", "[transport]
 
   rcb4::testing::served_board second;
   path = second.server->where();
-  c.set_reconnect(
-      [&](boost::asio::serial_port& s, std::error_code& e) { s = t::open_serial(io.context(), path, 1250000, e); });
+  c.set_reconnect([&](t::serial_port& s, std::error_code& e) { s = t::open_serial(io.context(), path, 1250000, e); });
   CHECK(c.execute(ping{}).kind == reply_kind::ack);
   CHECK(c.counters().reconnects == 1);
 }

@@ -20,10 +20,12 @@
 #include <rcb4/transport/concepts.hpp>
 #include <rcb4/transport/detail/exchange.hpp>
 #include <rcb4/transport/detail/fifo.hpp>
+#include <rcb4/transport/detail/handler_memory.hpp>
 #include <rcb4/transport/error.hpp>
 
 #include <boost/asio/any_completion_handler.hpp>
 #include <boost/asio/as_tuple.hpp>
+#include <boost/asio/bind_allocator.hpp>
 #include <boost/asio/bind_cancellation_slot.hpp>
 #include <boost/asio/cancellation_signal.hpp>
 #include <boost/asio/co_spawn.hpp>
@@ -197,7 +199,7 @@ class basic_client {
   auto async_execute(const command& c, Token&& token = {}) {
     return boost::asio::async_initiate<Token, signature>(
         [this](auto handler, const request& r) {
-          enqueue(pending{r, handler_type(std::move(handler)), 0});
+          enqueue(pending{r, erase(std::move(handler)), 0});
         },
         token, request{encode(c), expected_reply(c), is_idempotent(c)});
   }
@@ -282,6 +284,26 @@ class basic_client {
     const detail::exchange* ex = nullptr;
   };
   using clock = std::chrono::steady_clock;
+  // The worker's coroutines, its timer and its I/O completions run on the strand's own type (not
+  // any_io_executor): with a concrete stream executor (open_serial, connect) nothing is
+  // type-erased, so nothing is allocated per resumption.
+  using strand_type = boost::asio::strand<executor_type>;
+  template <class T>
+  using task = boost::asio::awaitable<T, strand_type>;
+  static constexpr boost::asio::use_awaitable_t<strand_type> use_task{};
+  using timer_type = boost::asio::basic_waitable_timer<clock, boost::asio::wait_traits<clock>, strand_type>;
+
+  /** The client's pool for its operations' memory. */
+  detail::handler_allocator<void> alloc() const noexcept { return detail::handler_allocator<void>(memory_); }
+
+  /** A queued handler, type-erased; one with no allocator of its own takes its memory from the pool. */
+  template <class Handler>
+  handler_type erase(Handler&& h) {
+    if constexpr (std::is_same_v<boost::asio::associated_allocator_t<std::decay_t<Handler>>, std::allocator<void>>)
+      return handler_type(boost::asio::bind_allocator(alloc(), std::forward<Handler>(h)));
+    else
+      return handler_type(std::forward<Handler>(h));
+  }
 
   /** Streams with a descriptor: blocking calls can do their I/O on the caller's thread. */
   static constexpr bool has_descriptor = requires(Stream & s) {
@@ -384,7 +406,7 @@ class basic_client {
       s.done = true;
       s.cv.notify_one();
     };
-    enqueue(pending{req, handler_type(std::move(h)), done}, holding_line);
+    enqueue(pending{req, erase(std::move(h)), done}, holding_line);
     std::unique_lock lock(s.m);
     s.cv.wait(lock, [&s] { return s.done; });
     ec = s.ec;
@@ -541,7 +563,7 @@ class basic_client {
 
   // --- the executor's driver: one coroutine works through the queue -----------------------------
 
-  boost::asio::awaitable<void> run() {
+  task<void> run() {
     for (;;) {
       pending p = [this] {
         std::lock_guard lock(m_);
@@ -555,6 +577,11 @@ class basic_client {
       // caller cannot see it before the line is released; releasing it is the last touch of
       // `this` (a destructor may be waiting for it).
       complete(std::move(p.handler), ec, r);
+      if (more_queued()) continue;
+      // Linger for one turn of the strand: the completion just posted runs first, and a request
+      // its handler makes (a callback chain, a coroutine's next co_await) finds this worker
+      // still here instead of spawning a new one (whose frames would be allocated again).
+      co_await boost::asio::post(strand_, boost::asio::bind_allocator(alloc(), use_task));
       std::promise<void>* idle = nullptr;
       {
         std::lock_guard lock(m_);
@@ -567,16 +594,23 @@ class basic_client {
     }
   }
 
+  bool more_queued() {
+    std::lock_guard lock(m_);
+    return !queue_.empty() && !closing_;
+  }
+
   /**
    * Queues @p h's completion on the strand, where it runs only once the worker has suspended or
    * finished, then on the handler's own executor.
    */
   void complete(handler_type h, std::error_code ec, const response& r) {
-    boost::asio::post(strand_, [h = std::move(h), ec, r, s = strand_]() mutable {
-      auto ex = boost::asio::get_associated_executor(h, s);
-      boost::asio::dispatch(ex,
-                            [h = std::move(h), ec, r]() mutable { std::move(h)(boost::system::error_code(ec), r); });
-    });
+    boost::asio::post(
+        strand_, boost::asio::bind_allocator(alloc(), [h = std::move(h), ec, r, s = strand_, a = alloc()]() mutable {
+          auto ex = boost::asio::get_associated_executor(h, s);
+          boost::asio::dispatch(ex, boost::asio::bind_allocator(a, [h = std::move(h), ec, r]() mutable {
+                                  std::move(h)(boost::system::error_code(ec), r);
+                                }));
+        }));
   }
 
   /** Starts the exchange's deadline: when it expires, the pending read or write is cancelled. */
@@ -584,18 +618,19 @@ class basic_client {
     timed_out_ = false;
     const auto gen = ++generation_;
     timer_.expires_after(d);
-    timer_.async_wait([this, gen](boost::system::error_code ec) {
+    timer_.async_wait(boost::asio::bind_allocator(alloc(), [this, gen](boost::system::error_code ec) {
       if (ec || gen != generation_) return;  // cancelled, or a stale timer of an earlier exchange
       timed_out_ = true;
       cancel_.emit(boost::asio::cancellation_type::terminal);
-    });
+    }));
   }
   void disarm() {
     ++generation_;
     timer_.cancel();
   }
   auto token() {
-    return boost::asio::bind_cancellation_slot(cancel_.slot(), boost::asio::as_tuple(boost::asio::use_awaitable));
+    return boost::asio::bind_cancellation_slot(cancel_.slot(),
+                                               boost::asio::as_tuple(boost::asio::bind_allocator(alloc(), use_task)));
   }
 
   /**
@@ -605,7 +640,7 @@ class basic_client {
    * within the ping's budget is errc::timeout: the line stays dirty, and the exchange counts it
    * as a timed-out attempt (a write is then not sent at all).
    */
-  boost::asio::awaitable<std::error_code> drain() {
+  task<std::error_code> drain() {
     static constexpr std::array<std::uint8_t, 4> ack{0x04, 0xFE, 0x06, 0x08};
     static const auto ping_frame = encode(ping{});
     const request sync{ping_frame, expected_reply(ping{}), true};
@@ -664,7 +699,7 @@ class basic_client {
   }
 
   /** Reopens the link with backoff until policy_.give_up_after. */
-  boost::asio::awaitable<std::error_code> reconnect() {
+  task<std::error_code> reconnect() {
     const auto give_up = clock::now() + policy_.give_up_after;
     auto delay = policy_.first_delay;
     for (;;) {
@@ -681,13 +716,13 @@ class basic_client {
       const auto now = clock::now();
       if (now >= give_up) co_return errc::reconnect_failed;
       timer_.expires_at(std::min(give_up, now + delay));
-      co_await timer_.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable));
+      co_await timer_.async_wait(boost::asio::as_tuple(use_task));
       delay = std::min(policy_.max_delay, delay * 2);
     }
   }
 
   /** Runs @p req's remaining attempts (after @p first made elsewhere). */
-  boost::asio::awaitable<std::error_code> perform(const request& req, response& out, unsigned first) {
+  task<std::error_code> perform(const request& req, response& out, unsigned first) {
     std::error_code ec = first > 0 ? std::error_code(errc::timeout) : std::error_code{};
     for (unsigned attempt = first; attempt < attempts(req); ++attempt) {
       if (attempt > 0) ++counters_.retries;
@@ -734,10 +769,13 @@ class basic_client {
     co_return ec;
   }
 
+  // The pool is shared with the operations it serves, and declared first so that it also
+  // outlives the stream's and the timer's own operations here.
+  std::shared_ptr<detail::handler_memory> memory_ = std::make_shared<detail::handler_memory>();
   Stream stream_;
   client_options opt_;
-  boost::asio::strand<executor_type> strand_;
-  boost::asio::steady_timer timer_;
+  strand_type strand_;
+  timer_type timer_;
   std::mutex m_;                 // guards queue_, busy_, closing_, idle_
   detail::fifo<pending> queue_;  // requests waiting for the line
   bool busy_ = false;            // a worker or a calling thread owns the line

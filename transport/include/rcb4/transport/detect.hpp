@@ -24,7 +24,7 @@ inline std::uint32_t detect_baud(boost::asio::io_context& io, const std::string&
     opt.baud = baud;
     opt.turnaround = turnaround;
     opt.read_retries = 1;
-    basic_client<boost::asio::serial_port> c(std::move(port), opt);
+    basic_client<serial_port> c(std::move(port), opt);
     std::error_code pe;
     const auto r = c.execute(ping{}, pe);
     if (!pe && r.kind == reply_kind::ack) {

@@ -54,6 +54,13 @@ inline std::optional<std::uint32_t> set_custom_baud(int fd, std::uint32_t baud) 
 }
 }  // namespace detail
 
+/**
+ * The serial port open_serial returns: Asio's, on the io_context's own executor type (not the
+ * type-erased any_io_executor), so that the client's strand and handlers allocate nothing per
+ * exchange. It converts to boost::asio::serial_port (by move) if you need that type.
+ */
+using serial_port = boost::asio::basic_serial_port<boost::asio::io_context::executor_type>;
+
 /** What open_serial found out about the port. */
 struct serial_info {
   std::uint32_t baud = 0;                    ///< rate read back from the driver
@@ -66,10 +73,10 @@ struct serial_info {
  * them) with 8E1, raw, exclusive. On failure @p ec says why: transport::errc::port_busy when
  * another program holds it, unsupported_baud when the rate does not read back, or the OS error.
  */
-inline boost::asio::serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
-                                            std::error_code& ec, serial_info* info = nullptr) {
+inline serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
+                               std::error_code& ec, serial_info* info = nullptr) {
   namespace asio = boost::asio;
-  asio::serial_port port(io);
+  serial_port port(io);
   boost::system::error_code bec;
   port.open(path, bec);
   if (bec) {
@@ -120,8 +127,8 @@ inline boost::asio::serial_port open_serial(boost::asio::io_context& io, const s
 inline constexpr std::uint32_t board_bauds[] = {1250000, 115200, 625000};
 
 /** open_serial that throws std::system_error. */
-inline boost::asio::serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
-                                            serial_info* info = nullptr) {
+inline serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
+                               serial_info* info = nullptr) {
   std::error_code ec;
   auto p = open_serial(io, path, baud, ec, info);
   if (ec) throw std::system_error(ec, "open " + path);

@@ -11,10 +11,16 @@
 
 namespace rcb4::transport {
 
+/**
+ * The socket connect returns: Asio's TCP socket on the io_context's own executor type (not the
+ * type-erased any_io_executor), so that the client allocates nothing per exchange. It converts
+ * to boost::asio::ip::tcp::socket (by move) if you need that type.
+ */
+using tcp_socket = boost::asio::basic_stream_socket<boost::asio::ip::tcp, boost::asio::io_context::executor_type>;
+
 /** Connects to "HOST:PORT" (names resolved; IPv6 as "[::1]:3333"), with TCP_NODELAY set. */
-inline boost::asio::ip::tcp::socket connect(boost::asio::io_context& io, const std::string& where,
-                                            std::error_code& ec) {
-  boost::asio::ip::tcp::socket socket(io);
+inline tcp_socket connect(boost::asio::io_context& io, const std::string& where, std::error_code& ec) {
+  tcp_socket socket(io);
   const auto colon = where.rfind(':');
   if (colon == std::string::npos || colon + 1 == where.size()) {
     ec = std::make_error_code(std::errc::invalid_argument);
@@ -32,7 +38,7 @@ inline boost::asio::ip::tcp::socket connect(boost::asio::io_context& io, const s
 }
 
 /** connect() that throws std::system_error. */
-inline boost::asio::ip::tcp::socket connect(boost::asio::io_context& io, const std::string& where) {
+inline tcp_socket connect(boost::asio::io_context& io, const std::string& where) {
   std::error_code ec;
   auto s = connect(io, where, ec);
   if (ec) throw std::system_error(ec, "connect " + where);
