@@ -151,6 +151,22 @@ TEST_CASE("client: a silent board times out within the deadline", "[transport]")
   CHECK(c.counters().timeouts == 4);
 }
 
+TEST_CASE("client: on a tty, a wait of whole tenths blocks in read() and still ends at its deadline", "[transport]") {
+  t::pty_pair silent;
+  t::io_thread io;
+  t::client_options opt;
+  opt.turnaround = 250ms;  // two tenths in a bounded read (the terminal's own timer), the rest in ppoll
+  opt.read_retries = 0;
+  auto c = open_client(io, silent.path(), opt);
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  c.execute(ping{}, ec);
+  const auto took = std::chrono::steady_clock::now() - start;
+  CHECK(ec == t::errc::timeout);
+  CHECK(took >= 250ms);  // not before the deadline
+  CHECK(took < 2s);      // a hang check, not a speed target
+}
+
 TEST_CASE("client: faults on the line never turn into wrong data, and the line recovers", "[transport]") {
   std::atomic<int> mode{0};
   t::serve_options so;

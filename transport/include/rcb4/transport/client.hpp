@@ -42,6 +42,7 @@
 #include <poll.h>
 #include <sys/ioctl.h>
 #include <sys/socket.h>
+#include <termios.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -498,13 +499,47 @@ class basic_client {
     }
   }
 
+  /** The descriptor's settings the caller-thread driver relies on, checked once per descriptor. */
+  struct direct_fd {
+    int fd = -1;
+    int flags = 0;     // file status flags, O_NONBLOCK included
+    bool tty = false;  // a terminal: reads can block with a VTIME bound
+    cc_t vtime = 0;    // the VTIME last set (VMIN is 0 once any is set)
+  };
+
+  /**
+   * A tty read that blocks (a blocking read wakes sooner than ppoll then read) for at most
+   * @p tenths of a second, the terminal's own timer (VMIN 0, VTIME): -2 when that passed
+   * with nothing read, otherwise read()'s result. The descriptor is non-blocking again after.
+   */
+  ssize_t bounded_tty_read(std::span<std::uint8_t> buf, cc_t tenths) {
+    const int fd = direct_.fd;
+    if (direct_.vtime != tenths) {
+      termios t{};
+      if (::tcgetattr(fd, &t) != 0) return -1;
+      t.c_cc[VMIN] = 0;
+      t.c_cc[VTIME] = tenths;
+      if (::tcsetattr(fd, TCSANOW, &t) != 0) return -1;
+      direct_.vtime = tenths;
+    }
+    const auto began = clock::now();
+    ::fcntl(fd, F_SETFL, direct_.flags & ~O_NONBLOCK);
+    const ssize_t n = ::read(fd, buf.data(), buf.size());
+    const int err = errno;
+    ::fcntl(fd, F_SETFL, direct_.flags);  // the executor's driver expects a non-blocking descriptor
+    errno = err;
+    if (n != 0) return n;
+    // Nothing: the timer ran out, or the terminal hung up (then read returns 0 at once).
+    return clock::now() - began >= std::chrono::milliseconds(100 * tenths - 20) ? -2 : 0;
+  }
+
   /** One attempt of @p req on this thread, driving @p ex (the caller holds the line). */
   attempt_result direct_attempt(detail::exchange& ex, const request& req) {
     const int fd = stream_.native_handle();
-    if (fd != nonblocking_fd_) {  // once per descriptor: every wait is a ppoll with a deadline
-      const int flags = ::fcntl(fd, F_GETFL);
-      if (flags >= 0 && (flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, flags | O_NONBLOCK);
-      nonblocking_fd_ = fd;
+    if (fd != direct_.fd) {  // once per descriptor: non-blocking, so that every wait has a deadline
+      direct_ = direct_fd{fd, ::fcntl(fd, F_GETFL), !is_socket && ::isatty(fd) == 1, 0};
+      if (direct_.flags >= 0 && (direct_.flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, direct_.flags | O_NONBLOCK);
+      direct_.flags |= O_NONBLOCK;
     }
     attempt_result a{{}, false, &ex};
     const auto start = clock::now();
@@ -518,11 +553,6 @@ class basic_client {
     trace(direction::tx, req.frame.bytes());
     while (ex.next() != detail::exchange::step::done) {
       const bool writing = ex.next() == detail::exchange::step::write;
-      if (!writing && !ready_before(fd, POLLIN, deadline, a.line, spin_from, spin_until)) {  // never there yet
-        a.timed_out = true;
-        break;
-      }
-      if (a.line) break;
       ssize_t n;
       if (writing) {
         const auto w = ex.to_write();
@@ -532,7 +562,23 @@ class basic_client {
           n = ::write(fd, w.data(), w.size());
       } else {
         const auto buf = ex.read_buffer();
-        n = ::read(fd, buf.data(), buf.size());
+        // A tty with whole tenths of a second left blocks in read() for at most those tenths;
+        // anything else (sockets, the last fraction, busy polling) waits in ppoll.
+        const auto tenths =
+            direct_.tty && opt_.busy_poll.count() == 0
+                ? std::min<std::int64_t>(255, (deadline - clock::now()) / std::chrono::milliseconds(100))
+                : 0;
+        if (tenths > 0) {
+          n = bounded_tty_read(buf, static_cast<cc_t>(tenths));
+          if (n == -2) continue;  // its tenths passed: the rest of the time goes to ppoll
+        } else {
+          if (!ready_before(fd, POLLIN, deadline, a.line, spin_from, spin_until)) {  // never there yet
+            a.timed_out = true;
+            break;
+          }
+          if (a.line) break;
+          n = ::read(fd, buf.data(), buf.size());
+        }
       }
       if (n > 0) {
         const auto k = static_cast<std::size_t>(n);
@@ -706,7 +752,7 @@ class basic_client {
       if (closing_) co_return errc::cancelled;
       std::error_code e;
       reopen_(stream_, e);
-      nonblocking_fd_ = -1;  // a new descriptor (possibly with the old number)
+      direct_ = direct_fd{};  // a new descriptor (possibly with the old number)
       if (!e) {
         lost_ = false;
         dirty_ = false;
@@ -785,7 +831,7 @@ class basic_client {
   bool dirty_ = false;
   bool lost_ = false;
   bool timed_out_ = false;
-  int nonblocking_fd_ = -1;
+  direct_fd direct_;  // the caller-thread driver's view of the descriptor
   std::function<void(Stream&, std::error_code&)> reopen_;
   reconnect_policy policy_;
   std::uint64_t generation_ = 0;
