@@ -37,15 +37,15 @@ class handler_memory {
     }
     return ::operator new(n);
   }
-  /** Gives back what allocate(@p n) returned. */
-  void deallocate(void* p, std::size_t n) noexcept {
+  /** Gives back what allocate() returned. */
+  void deallocate(void* p) noexcept {
     auto* b = static_cast<unsigned char*>(p);
     if (b >= storage_[0].bytes && b < storage_[0].bytes + sizeof storage_) {
       std::lock_guard lock(m_);
       used_[static_cast<std::size_t>(b - storage_[0].bytes) / sizeof(block)] = false;
       return;
     }
-    ::operator delete(p, n);
+    ::operator delete(p);
   }
 
  private:
@@ -74,7 +74,7 @@ class handler_allocator {
   /** Memory for @p n objects. */
   T* allocate(std::size_t n) { return static_cast<T*>(mem_->allocate(n * sizeof(T))); }
   /** Gives back @p p (from allocate(@p n)). */
-  void deallocate(T* p, std::size_t n) noexcept { mem_->deallocate(p, n * sizeof(T)); }
+  void deallocate(T* p, std::size_t /*n*/) noexcept { mem_->deallocate(p); }
   /** The pool. */
   const std::shared_ptr<handler_memory>& memory() const noexcept { return mem_; }
   /** Same pool, same allocator. */
