@@ -106,10 +106,11 @@ int main() {
     next();
     all_done.get_future().wait();
     const double async_us = us_since(start, n);
-    std::printf("  %-16s %6.0f/s (%5.1f us)   echo floor %6.0f/s = %.2fx (ping's, above)   %.1f allocs/exchange "
-                "(async API, callback chain)\n",
-                "ping (async)", 1e6 / async_us, async_us, 1e6 / ping_floor_us, ping_floor_us / async_us,
-                static_cast<double>(bench::allocations() - allocs) / n);
+    std::printf(
+        "  %-16s %6.0f/s (%5.1f us)   echo floor %6.0f/s = %.2fx (ping's, above)   %.1f allocs/exchange "
+        "(async API, callback chain)\n",
+        "ping (async)", 1e6 / async_us, async_us, 1e6 / ping_floor_us, ping_floor_us / async_us,
+        static_cast<double>(bench::allocations() - allocs) / n);
   }
   {
     // Control cycle at 1.25 Mbaud, paced: read all servo states (planned) + CONST to 36 servos.
