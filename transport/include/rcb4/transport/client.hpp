@@ -10,10 +10,11 @@
 // Requests from any thread queue FIFO; one exchange is on the line at a time, so the bytes of two
 // exchanges never interleave and no caller ever sees "busy". A worker coroutine on a strand of
 // the stream's executor works through the queue; a blocking call that finds the line idle does
-// its exchange on its own thread instead (no hand-off; client_options::direct_io). Each exchange has a
-// deadline computed from the wire (11 bits per byte at the configured baud) plus a turnaround
-// allowance. After a timeout, a bad frame or stray bytes, the next exchange first drains the line
-// until it has been quiet for a while. Idempotent reads are retried by policy.
+// its exchange on its own thread instead (no hand-off; client_options::direct_io). Both drive the
+// same sans-I/O exchange (detail/exchange.hpp). Each exchange has a deadline computed from the
+// wire (11 bits per byte at the configured baud) plus a turnaround allowance. After a timeout, a
+// bad frame or stray bytes, the next exchange first resynchronises: it sends a ping and discards
+// everything up to its ACK. Idempotent reads are retried by policy; a lost link can be reopened.
 #pragma once
 
 #include <rcb4/rcb4.hpp>
