@@ -3,7 +3,7 @@
 //    a pty against the virtual board, next to a raw pty echo floor (target >= 0.9x the floor)
 //    and a bare blocking loop sending the same frame to a second board server; floors and
 //    client take turns in rounds and the medians are printed (the machine's speed drifts);
-//  - the same with the async API (a callback chain);
+//  - the same with the async API (a callback chain), next to a bare Asio coroutine loop;
 //  - a control cycle (read every servo's state + write 36 servos) against the board paced at
 //    1.25 Mbaud, next to the wire limit of those bytes (target >= 0.97x) and to the same cycle
 //    by a bare blocking loop (what the pty allows any client);
@@ -106,11 +106,15 @@ int main() {
     next();
     all_done.get_future().wait();
     const double async_us = us_since(start, n);
+    const double async_allocs = static_cast<double>(bench::allocations() - allocs) / n;
+    const auto ping_frame = encode(ping{});
+    const std::vector<std::uint8_t> ping_bytes(ping_frame.bytes().begin(), ping_frame.bytes().end());
+    const double asio_us = rcb4::testing::asio_round_trips(raw_board.server->where(), ping_bytes, 4, n / 4);
     std::printf(
-        "  %-16s %6.0f/s (%5.1f us)   echo floor %6.0f/s = %.2fx (ping's, above)   %.1f allocs/exchange "
-        "(async API, callback chain)\n",
-        "ping (async)", 1e6 / async_us, async_us, 1e6 / ping_floor_us, ping_floor_us / async_us,
-        static_cast<double>(bench::allocations() - allocs) / n);
+        "  %-16s %6.0f/s (%5.1f us)   echo floor %6.0f/s = %.2fx (ping's)   bare Asio coroutine loop on a board "
+        "%6.0f/s = %.2fx   %.1f allocs/exchange\n",
+        "ping (async)", 1e6 / async_us, async_us, 1e6 / ping_floor_us, ping_floor_us / async_us, 1e6 / asio_us,
+        asio_us / async_us, async_allocs);
   }
   {
     // Control cycle at 1.25 Mbaud, paced: read all servo states (planned) + CONST to 36 servos.

@@ -78,6 +78,40 @@ inline double raw_cycle_us(const std::string& path, ops::link_cost cost, const c
   return ok ? us / n : -1.0;
 }
 
+/**
+ * Round trips of @p request on @p path by the least an Asio program can do: one coroutine on
+ * its own io_context thread writing and reading a stream_descriptor (no strand, no deadline);
+ * µs per round trip. The yardstick for asynchronous clients.
+ */
+inline double asio_round_trips(const std::string& path, std::span<const std::uint8_t> request, std::size_t reply_size,
+                               int n) {
+  boost::asio::io_context io;
+  boost::asio::posix::stream_descriptor s(io, ::open(path.c_str(), O_RDWR | O_NOCTTY));
+  termios t{};
+  ::tcgetattr(s.native_handle(), &t);
+  ::cfmakeraw(&t);
+  ::tcsetattr(s.native_handle(), TCSANOW, &t);
+  double us = -1.0;
+  boost::asio::co_spawn(
+      io,
+      [&]() -> boost::asio::awaitable<void> {
+        std::vector<std::uint8_t> buf(reply_size);
+        const auto start = std::chrono::steady_clock::now();
+        for (int i = 0; i < n; ++i) {
+          co_await boost::asio::async_write(s, boost::asio::buffer(request.data(), request.size()),
+                                            boost::asio::use_awaitable);
+          std::size_t got = 0;
+          while (got < reply_size)
+            got += co_await s.async_read_some(boost::asio::buffer(buf.data() + got, reply_size - got),
+                                              boost::asio::use_awaitable);
+        }
+        us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count() / n;
+      },
+      boost::asio::detached);
+  io.run();
+  return us;
+}
+
 /** Echoes every byte back on a new pty, on @p io (run by another thread): the floor any pty server can reach. */
 class pty_echo {
  public:
