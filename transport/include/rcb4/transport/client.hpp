@@ -346,10 +346,12 @@ class basic_client {
         busy_ = true;
       }
     }
-    if (holding_line)
+    if (holding_line) {
       hand_over_line();
-    else if (start)
+    } else if (start) {
+      nonblocking_for_worker();  // this thread owns the idle line until the worker starts
       boost::asio::co_spawn(strand_, run(), boost::asio::detached);  // never under m_: it may start inline
+    }
   }
 
   /** Takes the line for the calling thread if nothing runs or waits and it needs no resync. */
@@ -382,9 +384,10 @@ class basic_client {
         start = true;  // busy_ passes to the worker
       }
     }
-    if (start)
+    if (start) {
+      nonblocking_for_worker();
       boost::asio::co_spawn(strand_, run(), boost::asio::detached);
-    else if (idle)
+    } else if (idle)
       idle->set_value();  // the last touch of `this`: a destructor is waiting
   }
 
@@ -503,15 +506,29 @@ class basic_client {
   /** The descriptor's settings the caller-thread driver relies on, checked once per descriptor. */
   struct direct_fd {
     int fd = -1;
-    int flags = 0;     // file status flags, O_NONBLOCK included
-    bool tty = false;  // a terminal: reads can block with a VTIME bound
-    cc_t vtime = 0;    // the VTIME last set (VMIN is 0 once any is set)
+    int flags = 0;          // file status flags, O_NONBLOCK included
+    bool tty = false;       // a terminal: reads can block with a VTIME bound
+    cc_t vtime = 0;         // the VTIME last set (VMIN is 0 once any is set)
+    bool blocking = false;  // O_NONBLOCK is off (left so by bounded reads until the worker needs it)
   };
+
+  /**
+   * Before the worker takes the line (the caller owns it then): the descriptor back to
+   * non-blocking, as Asio's reactor requires.
+   */
+  void nonblocking_for_worker() {
+    if (!direct_.blocking) return;
+    ::fcntl(direct_.fd, F_SETFL, direct_.flags);
+    direct_.blocking = false;
+  }
 
   /**
    * A tty read that blocks (a blocking read wakes sooner than ppoll then read) for at most
    * @p tenths of a second, the terminal's own timer (VMIN 0, VTIME): -2 when that passed
-   * with nothing read, otherwise read()'s result. The descriptor is non-blocking again after.
+   * with nothing read, otherwise read()'s result. The descriptor stays blocking for the
+   * callers' next exchanges (their writes cannot block: the previous request has left, since
+   * its reply came, and after any timeout the line goes to the worker); the worker makes it
+   * non-blocking again when it takes the line.
    */
   ssize_t bounded_tty_read(std::span<std::uint8_t> buf, cc_t tenths) {
     const int fd = direct_.fd;
@@ -523,12 +540,12 @@ class basic_client {
       if (::tcsetattr(fd, TCSANOW, &t) != 0) return -1;
       direct_.vtime = tenths;
     }
+    if (!direct_.blocking) {
+      if (::fcntl(fd, F_SETFL, direct_.flags & ~O_NONBLOCK) != 0) return -1;
+      direct_.blocking = true;
+    }
     const auto began = clock::now();
-    ::fcntl(fd, F_SETFL, direct_.flags & ~O_NONBLOCK);
     const ssize_t n = ::read(fd, buf.data(), buf.size());
-    const int err = errno;
-    ::fcntl(fd, F_SETFL, direct_.flags);  // the executor's driver expects a non-blocking descriptor
-    errno = err;
     if (n != 0) return n;
     // Nothing: the timer ran out, or the terminal hung up (then read returns 0 at once).
     return clock::now() - began >= std::chrono::milliseconds(100 * tenths - 20) ? -2 : 0;
