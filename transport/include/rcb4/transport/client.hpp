@@ -179,16 +179,20 @@ class basic_client {
     std::promise<void> idle;
     auto done = idle.get_future();
     boost::asio::dispatch(strand_, [this, &idle] {
-      std::lock_guard lock(m_);
-      closing_ = true;
-      boost::system::error_code ignored;
-      stream_.close(ignored);
-      timer_.cancel();
-      while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
-      if (busy_)
-        idle_ = &idle;
-      else
-        idle.set_value();
+      bool idle_now = false;
+      {
+        std::lock_guard lock(m_);
+        closing_ = true;
+        boost::system::error_code ignored;
+        stream_.close(ignored);
+        timer_.cancel();
+        while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
+        if (busy_)
+          idle_ = &idle;
+        else
+          idle_now = true;
+      }
+      if (idle_now) idle.set_value();  // after unlocking: the waiting destructor then frees m_
     });
     done.wait();
   }
@@ -277,7 +281,8 @@ class basic_client {
   struct pending {
     request req;
     handler_type handler;
-    unsigned attempts_done = 0;  ///< attempts already made by the caller's thread
+    unsigned attempts_done = 0;   ///< attempts already made by the caller's thread
+    bool blocked_caller = false;  ///< a blocking execute() waits for it (its next call comes from that thread)
   };
   /** How one attempt on the line ended (before judging it). */
   struct attempt_result {
@@ -411,7 +416,7 @@ class basic_client {
       s.done = true;
       s.cv.notify_one();
     };
-    enqueue(pending{req, erase(std::move(h)), done}, holding_line);
+    enqueue(pending{req, erase(std::move(h)), done, true}, holding_line);
     std::unique_lock lock(s.m);
     s.cv.wait(lock, [&s] { return s.done; });
     ec = s.ec;
@@ -642,10 +647,12 @@ class basic_client {
       // `this` (a destructor may be waiting for it).
       complete(std::move(p.handler), ec, r);
       if (more_queued()) continue;
-      // Linger for one turn of the strand: the completion just posted runs first, and a request
-      // its handler makes (a callback chain, a coroutine's next co_await) finds this worker
-      // still here instead of spawning a new one (whose frames would be allocated again).
-      co_await boost::asio::post(strand_, boost::asio::bind_allocator(alloc(), use_task));
+      // After an asynchronous completion, linger for one turn of the strand: the completion just
+      // posted runs first, and a request its handler makes (a callback chain, a coroutine's next
+      // co_await) finds this worker still here instead of spawning a new one (whose frames would
+      // be allocated again). A blocked caller's next request comes from its own thread and should
+      // find the line idle, for the caller-thread driver: no lingering for it.
+      if (!p.blocked_caller) co_await boost::asio::post(strand_, boost::asio::bind_allocator(alloc(), use_task));
       std::promise<void>* idle = nullptr;
       {
         std::lock_guard lock(m_);
