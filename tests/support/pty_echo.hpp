@@ -16,24 +16,35 @@
 
 namespace rcb4::testing {
 
-/** Opens @p path raw and measures @p n round trips of @p request; µs per round trip. */
-inline double pty_round_trips(const std::string& path, std::span<const std::uint8_t> request, std::size_t reply_size,
-                              int n) {
+/** Opens @p path read-write in raw mode (the caller closes it); -1 on failure. */
+inline int open_raw(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
   termios t{};
   ::tcgetattr(fd, &t);
   ::cfmakeraw(&t);
   ::tcsetattr(fd, TCSANOW, &t);
+  return fd;
+}
+
+/** Writes @p request on @p fd, then reads exactly @p reply.size() bytes into @p reply; false on failure. */
+inline bool raw_round_trip(int fd, std::span<const std::uint8_t> request, std::span<std::uint8_t> reply) {
+  if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size())) return false;
+  std::size_t got = 0;
+  while (got < reply.size()) {
+    const auto r = ::read(fd, reply.data() + got, reply.size() - got);
+    if (r <= 0) return false;
+    got += static_cast<std::size_t>(r);
+  }
+  return true;
+}
+
+/** Opens @p path raw and measures @p n round trips of @p request; µs per round trip. */
+inline double pty_round_trips(const std::string& path, std::span<const std::uint8_t> request, std::size_t reply_size,
+                              int n) {
+  const int fd = open_raw(path);
   std::vector<std::uint8_t> buf(reply_size);
   const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < n; ++i) {
-    if (::write(fd, request.data(), request.size()) != static_cast<ssize_t>(request.size())) break;
-    std::size_t got = 0;
-    while (got < reply_size) {
-      const auto r = ::read(fd, buf.data() + got, reply_size - got);
-      if (r <= 0) break;
-      got += static_cast<std::size_t>(r);
-    }
+  for (int i = 0; i < n && raw_round_trip(fd, request, buf); ++i) {
   }
   const auto us = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count();
   ::close(fd);
@@ -46,24 +57,15 @@ inline double pty_round_trips(const std::string& path, std::span<const std::uint
  * exactly its reply's length: the least any client can spend on this line.
  */
 inline double raw_cycle_us(const std::string& path, ops::link_cost cost, const command& write, int n) {
-  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY);
-  termios t{};
-  ::tcgetattr(fd, &t);
-  ::cfmakeraw(&t);
-  ::tcsetattr(fd, TCSANOW, &t);
+  const int fd = open_raw(path);
   std::array<std::uint8_t, max_reply_size> buf{};
   bool ok = true;
   const auto exchange = [&](const command& c) {
     const auto frame = encode(c);
     const auto shape = expected_reply(c);
-    ok = ok && ::write(fd, frame.bytes().data(), frame.size()) == static_cast<ssize_t>(frame.size());
-    std::size_t got = 0;
-    while (ok && got < shape.frame_size()) {
-      const auto r = ::read(fd, buf.data() + got, shape.frame_size() - got);
-      ok = r > 0;
-      got += ok ? static_cast<std::size_t>(r) : 0;
-    }
-    const auto parsed = parse_reply(std::span(buf).first(got), shape);
+    const auto reply = std::span(buf).first(shape.frame_size());
+    ok = ok && raw_round_trip(fd, frame.bytes(), reply);
+    const auto parsed = parse_reply(reply, shape);
     ok = ok && parsed.status == parse_status::complete;
     return parsed.value;
   };
@@ -86,11 +88,7 @@ inline double raw_cycle_us(const std::string& path, ops::link_cost cost, const c
 inline double asio_round_trips(const std::string& path, std::span<const std::uint8_t> request, std::size_t reply_size,
                                int n) {
   boost::asio::io_context io;
-  boost::asio::posix::stream_descriptor s(io, ::open(path.c_str(), O_RDWR | O_NOCTTY));
-  termios t{};
-  ::tcgetattr(s.native_handle(), &t);
-  ::cfmakeraw(&t);
-  ::tcsetattr(s.native_handle(), TCSANOW, &t);
+  boost::asio::posix::stream_descriptor s(io, open_raw(path));
   double us = -1.0;
   boost::asio::co_spawn(
       io,
