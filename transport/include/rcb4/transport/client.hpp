@@ -351,12 +351,19 @@ class basic_client {
         busy_ = true;
       }
     }
-    if (holding_line) {
+    if (holding_line)
       hand_over_line();
-    } else if (start) {
-      nonblocking_for_worker();  // this thread owns the idle line until the worker starts
-      boost::asio::co_spawn(strand_, run(), boost::asio::detached);  // never under m_: it may start inline
-    }
+    else if (start)
+      start_worker();  // this thread owns the idle line until the worker starts
+  }
+
+  /**
+   * Gives the line, which the calling thread owns, to a new worker. Never under m_ (the worker
+   * may start inline); the descriptor goes back to non-blocking first, as Asio's reactor needs.
+   */
+  void start_worker() {
+    nonblocking_for_worker();
+    boost::asio::co_spawn(strand_, run(), boost::asio::detached);
   }
 
   /** Takes the line for the calling thread if nothing runs or waits and it needs no resync. */
@@ -389,10 +396,9 @@ class basic_client {
         start = true;  // busy_ passes to the worker
       }
     }
-    if (start) {
-      nonblocking_for_worker();
-      boost::asio::co_spawn(strand_, run(), boost::asio::detached);
-    } else if (idle)
+    if (start)
+      start_worker();
+    else if (idle)
       idle->set_value();  // the last touch of `this`: a destructor is waiting
   }
 
@@ -517,10 +523,7 @@ class basic_client {
     bool blocking = false;  // O_NONBLOCK is off (left so by bounded reads until the worker needs it)
   };
 
-  /**
-   * Before the worker takes the line (the caller owns it then): the descriptor back to
-   * non-blocking, as Asio's reactor requires.
-   */
+  /** The descriptor back to non-blocking if a caller's bounded read left it blocking (see start_worker). */
   void nonblocking_for_worker() {
     if (!direct_.blocking) return;
     ::fcntl(direct_.fd, F_SETFL, direct_.flags);
