@@ -17,7 +17,9 @@
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
+#include <sys/stat.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -46,6 +48,27 @@ static_assert(!t::AsyncByteStream<read_only>);
 namespace {
 auto open_client(t::io_thread& io, const std::string& path, t::client_options opt = {}) {
   return t::make_client(t::open_serial(io.context(), path, 1250000), std::move(opt));
+}
+
+/**
+ * Whether some epoll instance of this process watches @p fd (matched by number and inode in
+ * /proc/self/fdinfo): whether Asio's reactor would be woken by its input.
+ */
+bool watched_by_epoll(int fd) {
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return false;
+  char ino[32];
+  std::snprintf(ino, sizeof ino, "ino:%lx ", static_cast<unsigned long>(st.st_ino));
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    if (std::filesystem::read_symlink(e.path(), ec).string() != "anon_inode:[eventpoll]") continue;
+    std::ifstream info("/proc/self/fdinfo/" + e.path().filename().string());
+    for (std::string line; std::getline(info, line);) {
+      int n = -1;
+      if (std::sscanf(line.c_str(), "tfd: %d", &n) == 1 && n == fd && line.find(ino) != std::string::npos) return true;
+    }
+  }
+  return false;
 }
 
 /** One blocking exchange of @p cmd on @p c (its reply in @p reply, if given); how long it took. */
@@ -104,6 +127,48 @@ TEST_CASE("client: a blocking call on an idle line does its I/O on the caller's 
   CHECK(c.counters().exchanges == 4);
   CHECK(c.counters().bytes_out == 16);
   CHECK(c.counters().bytes_in == 16);
+}
+
+TEST_CASE("client: while blocking calls use the line, the reactor does not watch it", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  t::client_options opt;
+  opt.direct_io = GENERATE(true, false);
+  auto port = t::open_serial(io.context(), b.server->where(), 1250000);
+  const int fd = port.native_handle();
+  REQUIRE(watched_by_epoll(fd));  // Asio registers a descriptor when the stream takes it
+  auto c = t::make_client(std::move(port), opt);
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  // Parked on the caller's thread: its replies no longer wake the executor's thread as well.
+  CHECK(watched_by_epoll(fd) == !opt.direct_io);
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  CHECK(watched_by_epoll(fd) == !opt.direct_io);
+  // The worker takes it back (same descriptor) for the asynchronous API, then gives it up again.
+  CHECK(c.async_execute(ping{}, boost::asio::use_future).get().kind == reply_kind::ack);
+  CHECK(watched_by_epoll(fd));
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  CHECK(watched_by_epoll(fd) == !opt.direct_io);
+  // stream() gives it back to the stream, for settings.
+  CHECK(c.stream().native_handle() == fd);
+  CHECK(watched_by_epoll(fd));
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  CHECK(c.counters().exchanges == 5);
+}
+
+TEST_CASE("client: a parked socket goes back to the worker intact", "[transport]") {
+  board::virtual_board vb;
+  t::io_thread server_io;
+  auto server = t::board_server::serve_tcp(server_io.context(), vb, {boost::asio::ip::make_address("127.0.0.1"), 0});
+  {
+    t::io_thread io;
+    auto c = t::make_client(t::connect(io.context(), server->where()));
+    for (int i = 0; i < 3; ++i) {
+      CHECK(c.execute(ping{}).kind == reply_kind::ack);                                           // parked
+      CHECK(c.async_execute(version{}, boost::asio::use_future).get().kind == reply_kind::data);  // assigned back
+    }
+    CHECK(c.stream().remote_endpoint().port() != 0);
+  }
+  t::board_server::shutdown(server);
 }
 
 TEST_CASE("board_server: a paced reply never comes before the wire would have carried it", "[transport][pace]") {
@@ -393,4 +458,37 @@ TEST_CASE("client: operations run on the client, baud detection, bad addresses",
   CHECK(ec);
   t::connect(io.context(), "127.0.0.1:1", ec);  // nothing listens there
   CHECK(ec);
+}
+
+TEST_CASE("open_serial: 8E1, raw, the rate read back, exclusive, and clear errors", "[transport]") {
+  served_board b;
+  t::io_thread io;
+  t::serial_info info;
+  auto port = t::open_serial(io.context(), b.server->where(), 625000, &info);
+  CHECK(info.baud == 625000);
+  termios tio{};
+  REQUIRE(::tcgetattr(port.native_handle(), &tio) == 0);
+  CHECK((tio.c_cflag & CSIZE) == CS8);  // 8 data bits
+  // Even parity (protocol.md §1): a pty's driver drops PARENB (ptys have no parity), so only
+  // "not odd" shows here; the hardware tier (tests/hardware) checks PARENB on a real adapter.
+  CHECK((tio.c_cflag & PARODD) == 0);
+  CHECK((tio.c_cflag & CSTOPB) == 0);  // 1 stop bit
+  CHECK((tio.c_cflag & (CREAD | CLOCAL)) == (CREAD | CLOCAL));
+  CHECK((tio.c_cflag & CRTSCTS) == 0);                 // no flow control
+  CHECK((tio.c_iflag & (IXON | IXOFF | ICRNL)) == 0);  // no XON/XOFF, no translation
+  CHECK((tio.c_lflag & (ICANON | ECHO | ISIG)) == 0);  // raw
+  CHECK((tio.c_oflag & OPOST) == 0);
+  CHECK(tio.c_cc[VMIN] == 1);  // an empty non-blocking read is EAGAIN, not an end of file
+  std::error_code ec;
+  t::open_serial(io.context(), b.server->where(), 625000, ec);  // a second opener
+  CHECK(ec == t::errc::port_busy);
+  t::open_serial(io.context(), "/dev/null", 115200, ec);  // not a terminal
+  CHECK(ec == std::errc::inappropriate_io_control_operation);
+  t::open_serial(io.context(), "/dev/does-not-exist", 115200, ec);
+  CHECK(ec == std::errc::no_such_file_or_directory);
+  // The port works through the client at the rate it was opened at.
+  t::client_options opt;
+  opt.baud = 625000;
+  auto c = t::make_client(std::move(port), opt);
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);
 }

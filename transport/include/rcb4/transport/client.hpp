@@ -53,8 +53,10 @@
 #include <functional>
 #include <future>
 #include <mutex>
+#include <optional>
 #include <system_error>
 #include <thread>
+#include <variant>
 
 namespace rcb4::transport {
 
@@ -152,6 +154,19 @@ inline bool is_idempotent(const command& c) noexcept {
   return false;
 }
 
+namespace detail {
+/** A socket's protocol (to assign a released descriptor back), or nothing for other streams. */
+template <class Stream>
+struct protocol_of {
+  using type = std::monostate;
+};
+template <class Stream>
+requires requires { typename Stream::protocol_type; }
+struct protocol_of<Stream> {
+  using type = std::optional<typename Stream::protocol_type>;
+};
+}  // namespace detail
+
 /** An RCB-4 client over any AsyncByteStream. */
 template <AsyncByteStream Stream>
 class basic_client {
@@ -185,6 +200,7 @@ class basic_client {
         closing_ = true;
         boost::system::error_code ignored;
         stream_.close(ignored);
+        close_parked();
         timer_.cancel();
         while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
         if (busy_)
@@ -226,6 +242,7 @@ class basic_client {
     const request req{encode(c), expected_reply(c), is_idempotent(c)};
     if constexpr (has_descriptor) {
       if (opt_.direct_io && claim_idle_line()) {
+        park();
         if (bytes_waiting() > 0) {  // stray bytes (a late or duplicated reply): the worker resyncs first
           dirty_ = true;
           return wait_for(req, 0, true, ec);
@@ -262,8 +279,16 @@ class basic_client {
     policy_ = policy;
   }
 
-  /** The stream (for settings such as the baud rate; do not read or write it directly). */
-  Stream& stream() noexcept { return stream_; }
+  /**
+   * The stream (for settings such as the baud rate; do not read or write it directly). Call it
+   * only while no exchange runs: a descriptor the caller-thread driver had taken out of the
+   * reactor goes back to the stream first.
+   */
+  Stream& stream() {
+    std::lock_guard lock(m_);
+    if (!busy_) unpark();
+    return stream_;
+  }
   /** The options; change them only while no exchange runs. */
   client_options& options() noexcept { return opt_; }
   /** What the client has done so far. */
@@ -318,6 +343,14 @@ class basic_client {
   };
   /** Sockets are written with send(MSG_NOSIGNAL): a closed peer is an error, not SIGPIPE. */
   static constexpr bool is_socket = requires(Stream & s) { s.remote_endpoint(); };
+  /**
+   * Streams whose descriptor can leave the reactor and come back (stream descriptors, sockets):
+   * while blocking calls use it on their own threads, the descriptor is parked, so that its
+   * replies do not also wake the executor's thread (see park).
+   */
+  static constexpr bool can_park = has_descriptor && requires(Stream & s) {
+    { s.release() } -> std::convertible_to<int>;
+  };
 
   bool running_here() const {
     if constexpr (requires { stream_.get_executor().running_in_this_thread(); })
@@ -362,6 +395,7 @@ class basic_client {
    * may start inline); the descriptor goes back to non-blocking first, as Asio's reactor needs.
    */
   void start_worker() {
+    unpark();
     nonblocking_for_worker();
     boost::asio::co_spawn(strand_, run(), boost::asio::detached);
   }
@@ -371,7 +405,7 @@ class basic_client {
     std::lock_guard lock(m_);
     if (busy_ || closing_ || dirty_ || lost_) return false;  // (dirty_/lost_ are read only while idle)
     if constexpr (requires { stream_.is_open(); })
-      if (!stream_.is_open()) return false;  // the worker reports (or reopens) it
+      if (parked_ < 0 && !stream_.is_open()) return false;  // the worker reports (or reopens) it
     busy_ = true;
     return true;
   }
@@ -431,12 +465,12 @@ class basic_client {
 
   /** Bytes already waiting on the line (0 when the stream cannot tell). */
   std::size_t bytes_waiting() {
-    if constexpr (requires(boost::system::error_code & e) { stream_.available(e); }) {
+    if constexpr (has_descriptor) {
+      int n = 0;  // serial ports, descriptors, sockets: ask the driver
+      return ::ioctl(line_fd(), FIONREAD, &n) == 0 && n > 0 ? static_cast<std::size_t>(n) : 0;
+    } else if constexpr (requires(boost::system::error_code & e) { stream_.available(e); }) {
       boost::system::error_code e;
       return stream_.available(e);
-    } else if constexpr (has_descriptor) {
-      int n = 0;  // serial ports and descriptors: ask the driver
-      return ::ioctl(stream_.native_handle(), FIONREAD, &n) == 0 && n > 0 ? static_cast<std::size_t>(n) : 0;
     } else {
       return 0;
     }
@@ -523,6 +557,55 @@ class basic_client {
     bool blocking = false;  // O_NONBLOCK is off (left so by bounded reads until the worker needs it)
   };
 
+  /** The line's descriptor, parked or in the stream. */
+  int line_fd() {
+    if constexpr (can_park)
+      if (parked_ >= 0) return parked_;
+    return stream_.native_handle();
+  }
+
+  /**
+   * Takes the descriptor out of the reactor while the calling thread owns the line. Asio
+   * watches a descriptor from the moment its stream opens it; left there, every reply that a
+   * caller's blocking read takes would also wake the executor's thread in epoll_wait (edge
+   * triggered, for nothing): on a fast line that second wake-up costs about as much as the
+   * client's own work. The stream releases it (the number stays the same) and the worker
+   * assigns it back before its first operation (unpark).
+   */
+  void park() {
+    if constexpr (can_park) {
+      if (parked_ >= 0 || !stream_.is_open()) return;
+      boost::system::error_code e;
+      if constexpr (is_socket) protocol_.emplace(stream_.local_endpoint(e).protocol());
+      if (e) return;  // stays in the stream: the worker will report what is wrong with it
+      if constexpr (requires { stream_.release(e); })
+        parked_ = stream_.release(e);  // (a socket's; it fails on no POSIX system)
+      else
+        parked_ = stream_.release();  // (a descriptor's; it cannot fail)
+      if (e) parked_ = -1;
+    }
+  }
+  /** Gives a parked descriptor back to the stream (and the reactor); the owner of the line calls it. */
+  void unpark() {
+    if constexpr (can_park) {
+      if (parked_ < 0) return;
+      boost::system::error_code e;
+      if constexpr (is_socket)
+        stream_.assign(*protocol_, parked_, e);
+      else
+        stream_.assign(parked_, e);
+      if (e) ::close(parked_);  // the stream stays closed: the next exchange reports errc::closed
+      parked_ = -1;
+    }
+  }
+  /** Closes a parked descriptor (the client is going away). */
+  void close_parked() {
+    if constexpr (can_park) {
+      if (parked_ >= 0) ::close(parked_);
+      parked_ = -1;
+    }
+  }
+
   /** The descriptor back to non-blocking if a caller's bounded read left it blocking (see start_worker). */
   void nonblocking_for_worker() {
     if (!direct_.blocking) return;
@@ -561,7 +644,7 @@ class basic_client {
 
   /** One attempt of @p req on this thread, driving @p ex (the caller holds the line). */
   attempt_result direct_attempt(detail::exchange& ex, const request& req) {
-    const int fd = stream_.native_handle();
+    const int fd = line_fd();
     if (fd != direct_.fd) {  // once per descriptor: non-blocking, so that every wait has a deadline
       direct_ = direct_fd{fd, ::fcntl(fd, F_GETFL), !is_socket && ::isatty(fd) == 1, 0};
       if (direct_.flags >= 0 && (direct_.flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, direct_.flags | O_NONBLOCK);
@@ -860,6 +943,8 @@ class basic_client {
   bool lost_ = false;
   bool timed_out_ = false;
   direct_fd direct_;  // the caller-thread driver's view of the descriptor
+  int parked_ = -1;   // the descriptor while out of the reactor (see park), else -1
+  [[no_unique_address]] typename detail::protocol_of<Stream>::type protocol_{};  // a parked socket's
   std::function<void(Stream&, std::error_code&)> reopen_;
   reconnect_policy policy_;
   std::uint64_t generation_ = 0;

@@ -1,17 +1,22 @@
 // rcb4 — opening a serial port the way the RCB-4 needs it (Linux).
 // SPDX-License-Identifier: BSL-1.0
 //
-// 8 data bits, even parity, 1 stop bit (protocol.md §1). Asio sets 8E1 and standard rates; for
-// 625000 and 1250000 (which Asio rejects) termios2 BOTHER is applied last and read back. The
-// port is taken exclusively (flock + TIOCEXCL) so a second program gets a clear "port busy"
-// instead of garbled exchanges. FTDI adapters get ASYNC_LOW_LATENCY as a best effort; their
-// latency timer (ms) is reported when sysfs shows it.
+// 8 data bits, even parity, 1 stop bit, raw (protocol.md §1), set with termios; the rate
+// (115200, 625000, 1250000: the last two are not standard termios rates) with termios2 BOTHER,
+// applied last and read back. The port is taken exclusively (flock + TIOCEXCL) so a second
+// program gets a clear "port busy" instead of garbled exchanges. FTDI adapters get
+// ASYNC_LOW_LATENCY as a best effort; their latency timer (ms) is reported when sysfs shows it.
+// The port is an Asio stream descriptor: the client can take it out of the reactor
+// (release/assign) while blocking calls do their I/O on the caller's thread.
 #pragma once
 
 #include <rcb4/transport/error.hpp>
 
 #include <boost/asio/io_context.hpp>
-#include <boost/asio/serial_port.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <linux/serial.h>
 #include <sys/file.h>
@@ -55,11 +60,13 @@ inline std::optional<std::uint32_t> set_custom_baud(int fd, std::uint32_t baud) 
 }  // namespace detail
 
 /**
- * The serial port open_serial returns: Asio's, on the io_context's own executor type (not the
- * type-erased any_io_executor), so that the client's strand and handlers allocate nothing per
- * exchange. It converts to boost::asio::serial_port (by move) if you need that type.
+ * The serial port open_serial returns: an Asio stream descriptor on the io_context's own
+ * executor type (not the type-erased any_io_executor), so that the client's strand and
+ * handlers allocate nothing per exchange, and with release()/assign(), so that the client can
+ * take the descriptor out of the reactor while its blocking calls use it (see basic_client).
+ * Its settings are termios (tcgetattr, or detail::set_custom_baud for the rate).
  */
-using serial_port = boost::asio::basic_serial_port<boost::asio::io_context::executor_type>;
+using serial_port = boost::asio::posix::basic_stream_descriptor<boost::asio::io_context::executor_type>;
 
 /** What open_serial found out about the port. */
 struct serial_info {
@@ -75,37 +82,36 @@ struct serial_info {
  */
 inline serial_port open_serial(boost::asio::io_context& io, const std::string& path, std::uint32_t baud,
                                std::error_code& ec, serial_info* info = nullptr) {
-  namespace asio = boost::asio;
   serial_port port(io);
-  boost::system::error_code bec;
-  port.open(path, bec);
-  if (bec) {
-    ec = bec;
+  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    ec = std::error_code(errno, std::generic_category());
     return port;
   }
-  const int fd = port.native_handle();
-  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
-    ec = errno == EWOULDBLOCK ? std::error_code(errc::port_busy) : std::error_code(errno, std::generic_category());
-    port.close(bec);
-    return port;
-  }
+  const auto fail = [&](std::error_code e) {
+    ec = e;
+    ::close(fd);
+    return std::move(port);
+  };
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0)
+    return fail(errno == EWOULDBLOCK ? std::error_code(errc::port_busy)
+                                     : std::error_code(errno, std::generic_category()));
   ::ioctl(fd, TIOCEXCL);  // best effort: ptys and some drivers refuse it
-  port.set_option(asio::serial_port_base::character_size(8), bec);
-  if (!bec) port.set_option(asio::serial_port_base::parity(asio::serial_port_base::parity::even), bec);
-  if (!bec) port.set_option(asio::serial_port_base::stop_bits(asio::serial_port_base::stop_bits::one), bec);
-  if (!bec) port.set_option(asio::serial_port_base::flow_control(asio::serial_port_base::flow_control::none), bec);
-  if (!bec) port.set_option(asio::serial_port_base::baud_rate(115200), bec);
-  if (bec) {
-    ec = bec;
-    port.close(bec);
-    return port;
-  }
-  const auto actual = detail::set_custom_baud(fd, baud);  // applied last, after Asio's settings
-  if (!actual || (*actual > baud ? *actual - baud : baud - *actual) > baud / 50) {  // > 2 % off
-    ec = errc::unsupported_baud;
-    port.close(bec);
-    return port;
-  }
+  termios t{};
+  if (::tcgetattr(fd, &t) != 0) return fail(std::error_code(errno, std::generic_category()));
+  ::cfmakeraw(&t);                       // no echo, no line editing, no translations, 8 bits
+  t.c_cflag |= CREAD | CLOCAL | PARENB;  // receive; ignore modem lines; even parity (PARODD off)
+  t.c_cflag &= ~static_cast<tcflag_t>(PARODD | CSTOPB | CRTSCTS);  // one stop bit, no RTS/CTS
+  t.c_iflag &= ~static_cast<tcflag_t>(IGNPAR | PARMRK | IXON | IXOFF);
+  t.c_iflag |= INPCK;  // check parity: a bad byte reads as 0, and the frame's checksum rejects it
+  t.c_cc[VMIN] = 1;    // (VMIN 0 with VTIME 0 would make an empty read return 0, as at end of file)
+  t.c_cc[VTIME] = 0;
+  ::cfsetispeed(&t, B115200);
+  ::cfsetospeed(&t, B115200);
+  if (::tcsetattr(fd, TCSANOW, &t) != 0) return fail(std::error_code(errno, std::generic_category()));
+  const auto actual = detail::set_custom_baud(fd, baud);  // applied last, after the termios settings
+  if (!actual || (*actual > baud ? *actual - baud : baud - *actual) > baud / 50)  // > 2 % off
+    return fail(errc::unsupported_baud);
   serial_info si;
   si.baud = *actual;
   serial_struct ss{};
@@ -118,6 +124,9 @@ inline serial_port open_serial(boost::asio::io_context& io, const std::string& p
   unsigned ms = 0;
   if (timer >> ms) si.latency_timer_ms = ms;
   ::tcflush(fd, TCIOFLUSH);
+  boost::system::error_code bec;
+  port.assign(fd, bec);
+  if (bec) return fail(bec);
   if (info) *info = si;
   ec.clear();
   return port;
