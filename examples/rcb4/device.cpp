@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "cli.hpp"
 
+#include <rcb4/transport/cpu_latency.hpp>
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -41,7 +43,9 @@ device commands (no --device: an in-process virtual board, so all of them work w
   motion play N [--wait] [--timeout S] [--layout 1.3|2.0|2.2] [--release]
   motion stop|resume|status         suspend / continue / show the ROM program's motion state
   motion wait [--timeout S]         until no motion runs, with a progress line
-  bench [--count N]                 round trips and control cycles per second vs the wire limit
+  bench [--count N] [--low-latency] round trips and control cycles per second vs the wire limit;
+                                    --low-latency holds the CPUs' wake-up latency at 0 us meanwhile
+                                    (a PM QoS request on /dev/cpu_dma_latency: root)
 
 other commands: list, doctor, decode, encode, serve (each has --help)
 )";
@@ -572,6 +576,18 @@ int motion_cmd(session& s, const parsed& p, const globals& g) {
 int bench_cmd(session& s, const parsed& p, const globals& g) {
   no_more(p, 0);
   const auto n = p.value("--count") ? parse_int(*p.value("--count"), "--count", 1, 10000000) : 500;
+  std::optional<rcb4::transport::cpu_latency_guard> low;
+  if (p.flag("--low-latency")) {
+    low.emplace(0us);
+    if (!low->active()) {
+      fmt::print(stderr,
+                 "rcb4 bench: --low-latency: cannot write /dev/cpu_dma_latency: {}\n"
+                 "  run as root, or let a group write it (udev: KERNEL==\"cpu_dma_latency\", GROUP=\"dialout\", "
+                 "MODE=\"0660\")\n",
+                 low->error().message());
+      return exit_io;
+    }
+  }
   auto wire_us = [&](std::size_t bytes) { return static_cast<double>(bytes) * 11e6 / s.baud(); };
   auto rate = [&](auto&& one) {
     const auto t0 = std::chrono::steady_clock::now();
@@ -611,7 +627,8 @@ int bench_cmd(session& s, const parsed& p, const globals& g) {
         s.baud(), ping_rate, ping_limit, read_rate, read_limit, cycle_rate, cycle_limit, cycle_bytes);
     return exit_ok;
   }
-  fmt::print("rcb4 bench against {} at {} baud, {} runs each\n", s.where(), s.baud(), n);
+  fmt::print("rcb4 bench against {} at {} baud, {} runs each{}\n", s.where(), s.baud(), n,
+             low ? ", CPU wake-up latency held at 0 us" : "");
   fmt::print("  {:<40} {:>9.0f}/s   wire limit {:>9.0f}/s   {:.2f}x\n", "ping", ping_rate, ping_limit,
              ping_rate / ping_limit);
   fmt::print("  {:<40} {:>9.0f}/s   wire limit {:>9.0f}/s   {:.2f}x\n", "MOV read 2 bytes", read_rate, read_limit,
@@ -647,7 +664,7 @@ int device_command(const args& a, const globals& g) {
       {"sensors", sensors_cmd, {}, {}},
       {"monitor", monitor_cmd, {"--hz", "--count"}, {}},
       {"motion", motion_cmd, {"--timeout", "--layout"}, {"--wait", "--release"}},
-      {"bench", bench_cmd, {"--count"}, {}},
+      {"bench", bench_cmd, {"--count"}, {"--low-latency"}},
   };
   for (const auto& e : table)
     if (e.name == a.command) {

@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "cli.hpp"
 
+#include <rcb4/transport/cpu_latency.hpp>
 #include <rcb4/transport/detect.hpp>
 
 #include <grp.h>
@@ -194,6 +195,14 @@ int doctor(const args& a, const globals& g) {
          rule ? fmt::format("udev rule installed: {}", rule->string()) : "rcb4 udev rule not installed",
          "sudo cp cmake/udev/60-rcb4.rules /etc/udev/rules.d/ && sudo udevadm control --reload && sudo udevadm trigger "
          "(cmake --install does this when installing to /usr)");
+  // Not a failure: a note for control loops (each exchange sleeps until bytes arrive).
+  const auto bound = rcb4::transport::cpu_latency_bound_us();
+  if (bound >= 0)
+    fmt::print(
+        "[ -- ] CPU wake-up latency: {}; a control loop can hold it at 0 us for its lifetime with "
+        "rcb4::transport::cpu_latency_guard (root), as `rcb4 bench --low-latency` does\n",
+        bound >= 1'000'000 ? std::string("no bound (idle states as configured)")
+                           : fmt::format("bounded at {} us", bound));
   for (const auto& path : candidates) {
     fmt::print("-- {}\n", path);
     if (path.rfind("tcp:", 0) != 0) {

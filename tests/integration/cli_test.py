@@ -136,6 +136,23 @@ expect_ok(["motion", "resume"], "resumed")
 expect_rc(["motion", "play", "121"], 2, "outside 1..120")
 expect_rc(["motion", "play", "1", "--layout", "9.9"], 2, "--layout")
 expect_ok(["bench", "--count", "20"], "control cycle")
+rc, out, err = run("bench", "--count", "20", "--low-latency")
+if os.access("/dev/cpu_dma_latency", os.W_OK):
+    check(rc == 0 and "held at 0 us" in out, "bench --low-latency holds the PM QoS request")
+else:
+    check(rc == 3 and "cpu_dma_latency" in err, "bench --low-latency without permission: exit 3, says why")
+if os.geteuid() == 0:  # as a user without root, as most users run it
+    def nobody():
+        os.setgroups([])
+        os.setgid(65534)
+        os.setuid(65534)
+    p = subprocess.run([RCB4, "ping"], capture_output=True, text=True, timeout=60, preexec_fn=nobody, cwd="/")
+    # detect_baud opens the port, then the session opens it again: the first client's exclusive
+    # mode (TIOCEXCL) must have ended with it, or the second open fails with EBUSY.
+    check(p.returncode == 0 and "ACK" in p.stdout, "ping as a user without root (port reopened after detection)")
+    p = subprocess.run([RCB4, "bench", "--count", "5", "--low-latency"], capture_output=True, text=True, timeout=60,
+                       preexec_fn=nobody, cwd="/")
+    check(p.returncode == 3 and "cpu_dma_latency" in p.stderr, "bench --low-latency without root: exit 3, says why")
 rc, out, err = run("--trace", "ping")
 check(rc == 0 and "-> 04 FE 06 08" in err and "<- 04 FE 06 08" in err and "ACK" in err, "--trace shows frames with meaning")
 

@@ -17,6 +17,7 @@
 #include <catch2/catch.hpp>
 
 #include <fcntl.h>
+#include <sys/ioctl.h>
 #include <sys/stat.h>
 
 #include <cstdio>
@@ -486,9 +487,26 @@ TEST_CASE("open_serial: 8E1, raw, the rate read back, exclusive, and clear error
   CHECK(ec == std::errc::inappropriate_io_control_operation);
   t::open_serial(io.context(), "/dev/does-not-exist", 115200, ec);
   CHECK(ec == std::errc::no_such_file_or_directory);
-  // The port works through the client at the rate it was opened at.
-  t::client_options opt;
-  opt.baud = 625000;
-  auto c = t::make_client(std::move(port), opt);
-  CHECK(c.execute(ping{}).kind == reply_kind::ack);
+  // Exclusive mode is the terminal's, not the descriptor's: it must end with the client, or the
+  // next open by a user without root fails with EBUSY while the pty's server holds it open.
+  int other = ::open(b.server->where().c_str(), O_RDWR | O_NOCTTY);  // root may open it anyway
+  int exclusive = -1;
+  if (other < 0) {
+    CHECK(errno == EBUSY);  // not root: exclusive mode refuses a second opener
+  } else {
+    REQUIRE(::ioctl(other, TIOCGEXCL, &exclusive) == 0);
+    CHECK(exclusive == 1);
+  }
+  {
+    // The port works through the client at the rate it was opened at.
+    t::client_options opt;
+    opt.baud = 625000;
+    auto c = t::make_client(std::move(port), opt);
+    CHECK(c.execute(ping{}).kind == reply_kind::ack);  // (the descriptor is parked when the client goes)
+  }
+  if (other < 0) other = ::open(b.server->where().c_str(), O_RDWR | O_NOCTTY);
+  REQUIRE(other >= 0);
+  REQUIRE(::ioctl(other, TIOCGEXCL, &exclusive) == 0);
+  CHECK(exclusive == 0);
+  ::close(other);
 }

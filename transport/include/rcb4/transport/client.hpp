@@ -190,7 +190,10 @@ class basic_client {
    * queued then fail with errc::cancelled. No blocking execute() may be running in another thread.
    */
   ~basic_client() {
-    if (running_here()) return;  // the executor's own thread: nothing can be in flight concurrently
+    if (running_here()) {  // the executor's own thread: nothing can be in flight concurrently
+      let_go_of_line();
+      return;
+    }
     std::promise<void> idle;
     auto done = idle.get_future();
     boost::asio::dispatch(strand_, [this, &idle] {
@@ -198,9 +201,7 @@ class basic_client {
       {
         std::lock_guard lock(m_);
         closing_ = true;
-        boost::system::error_code ignored;
-        stream_.close(ignored);
-        close_parked();
+        let_go_of_line();
         timer_.cancel();
         while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
         if (busy_)
@@ -598,12 +599,23 @@ class basic_client {
       parked_ = -1;
     }
   }
-  /** Closes a parked descriptor (the client is going away). */
-  void close_parked() {
+  /**
+   * The client is going away: a terminal's exclusive mode (TIOCEXCL, which open_serial sets)
+   * is cleared, since it outlives this descriptor while anyone else holds the terminal open (a
+   * pty's server, for one) and would turn the next open by a user without root into EBUSY; then
+   * the stream, or its parked descriptor, is closed.
+   */
+  void let_go_of_line() {
+    if constexpr (has_descriptor) {
+      const int fd = line_fd();
+      if (fd >= 0 && ::isatty(fd) == 1) ::ioctl(fd, TIOCNXCL);
+    }
     if constexpr (can_park) {
       if (parked_ >= 0) ::close(parked_);
       parked_ = -1;
     }
+    boost::system::error_code ignored;
+    stream_.close(ignored);
   }
 
   /** The descriptor back to non-blocking if a caller's bounded read left it blocking (see start_worker). */

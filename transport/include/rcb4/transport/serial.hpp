@@ -84,8 +84,8 @@ inline serial_port open_serial(boost::asio::io_context& io, const std::string& p
                                std::error_code& ec, serial_info* info = nullptr) {
   serial_port port(io);
   const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    ec = std::error_code(errno, std::generic_category());
+  if (fd < 0) {  // EBUSY: another program holds the terminal in exclusive mode (TIOCEXCL)
+    ec = errno == EBUSY ? std::error_code(errc::port_busy) : std::error_code(errno, std::generic_category());
     return port;
   }
   const auto fail = [&](std::error_code e) {
