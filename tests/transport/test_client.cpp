@@ -240,6 +240,32 @@ TEST_CASE("client: a silent board times out within the deadline", "[transport]")
   CHECK(c.counters().timeouts == 4);
 }
 
+TEST_CASE("client: a deadline earlier than the previous exchange's still holds", "[transport]") {
+  // The worker's timer watches many exchanges with one wait while deadlines only move later; a
+  // shorter deadline must replace that wait, or it would fire when the earlier, longer one ends.
+  std::atomic<bool> silent{false};
+  t::serve_options so;
+  so.tamper = [&silent](std::vector<std::uint8_t>& reply) {
+    if (silent) reply.clear();
+  };
+  served_board b(so);
+  t::io_thread io;
+  t::client_options opt;
+  opt.direct_io = false;  // the worker (and its timer) runs every exchange
+  opt.turnaround = 30s;
+  auto c = open_client(io, b.server->where(), opt);
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);  // leaves a wait outstanding until ~30 s from now
+  c.options().turnaround = 20ms;
+  silent = true;
+  std::error_code ec;
+  const auto took = timed_execute(c, ping{}, ec);
+  CHECK(ec == t::errc::timeout);
+  CHECK(c.counters().timeouts == 3);
+  CHECK(took < 2s);  // a hang check: 3 × (20 ms + wire time), where the stale wait would take 30 s
+  silent = false;
+  CHECK(c.execute(ping{}).kind == reply_kind::ack);  // and the line recovers
+}
+
 TEST_CASE("client: on a tty, a wait of whole tenths blocks in read() and still ends at its deadline", "[transport]") {
   t::pty_pair silent;
   t::io_thread io;

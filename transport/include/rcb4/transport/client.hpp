@@ -181,7 +181,11 @@ class basic_client {
 
   /** A client that owns @p stream. */
   explicit basic_client(Stream stream, client_options opt = {})
-      : stream_(std::move(stream)), opt_(std::move(opt)), strand_(stream_.get_executor()), timer_(strand_) {}
+      : stream_(std::move(stream)),
+        opt_(std::move(opt)),
+        strand_(stream_.get_executor()),
+        timer_(strand_),
+        backoff_(strand_) {}
   basic_client(const basic_client&) = delete;
   basic_client& operator=(const basic_client&) = delete;
   /**
@@ -191,6 +195,7 @@ class basic_client {
    */
   ~basic_client() {
     if (running_here()) {  // the executor's own thread: nothing can be in flight concurrently
+      watch_->owner = nullptr;
       let_go_of_line();
       return;
     }
@@ -201,8 +206,10 @@ class basic_client {
       {
         std::lock_guard lock(m_);
         closing_ = true;
-        let_go_of_line();
+        let_go_of_line();  // (the worker's I/O now ends at once: no deadline is needed any more)
+        watch_->owner = nullptr;
         timer_.cancel();
+        backoff_.cancel();
         while (!queue_.empty()) complete(queue_.pop_front().handler, errc::cancelled, response{});
         if (busy_)
           idle_ = &idle;
@@ -782,20 +789,50 @@ class basic_client {
         }));
   }
 
-  /** Starts the exchange's deadline: when it expires, the pending read or write is cancelled. */
+  /**
+   * Starts the exchange's deadline: when it passes, the pending read or write is cancelled. One
+   * wait on the timer watches many exchanges: a new deadline later than the wait's expiry (the
+   * usual case: the exchanges follow one another) leaves the wait alone, and when it fires
+   * during a later exchange it waits again, for that exchange's deadline. So the timer is set
+   * about once per turnaround allowance instead of twice per exchange (each time a timerfd
+   * system call, and a cancelled wait's completion through the strand).
+   */
   void arm(clock::duration d) {
     timed_out_ = false;
+    deadline_ = clock::now() + d;
+    guarding_ = true;
+    if (!waiting_ || wait_until_ > deadline_) watch_until(deadline_);
+  }
+  /** The exchange has ended: its deadline no longer applies (the wait stays, for the next one). */
+  void disarm() { guarding_ = false; }
+
+  /** What a timer wait's completion may touch after its client has gone: nothing, then. */
+  struct deadline_watch {
+    basic_client* owner;  // null once the client is going away (set on the strand)
+  };
+
+  /** Waits on the timer until @p t, replacing an outstanding wait (whose completion is then stale). */
+  void watch_until(clock::time_point t) {
     const auto gen = ++generation_;
-    timer_.expires_after(d);
-    timer_.async_wait(boost::asio::bind_allocator(alloc(), [this, gen](boost::system::error_code ec) {
-      if (ec || gen != generation_) return;  // cancelled, or a stale timer of an earlier exchange
-      timed_out_ = true;
-      cancel_.emit(boost::asio::cancellation_type::terminal);
+    waiting_ = true;
+    wait_until_ = t;
+    timer_.expires_at(t);
+    timer_.async_wait(boost::asio::bind_allocator(alloc(), [w = watch_, gen](boost::system::error_code ec) {
+      basic_client* self = w->owner;
+      if (!self || gen != self->generation_) return;  // the client has gone, or a newer wait replaced this one
+      self->waiting_ = false;
+      if (!ec) self->deadline_reached();
     }));
   }
-  void disarm() {
-    ++generation_;
-    timer_.cancel();
+  /** The wait fired: the running exchange's deadline has passed, or it waits again for it. */
+  void deadline_reached() {
+    if (!guarding_) return;  // between exchanges: the next arm() starts a new wait
+    if (clock::now() < deadline_) {
+      watch_until(deadline_);
+      return;
+    }
+    timed_out_ = true;
+    cancel_.emit(boost::asio::cancellation_type::terminal);
   }
   auto token() {
     return boost::asio::bind_cancellation_slot(cancel_.slot(),
@@ -884,8 +921,8 @@ class basic_client {
       }
       const auto now = clock::now();
       if (now >= give_up) co_return errc::reconnect_failed;
-      timer_.expires_at(std::min(give_up, now + delay));
-      co_await timer_.async_wait(boost::asio::as_tuple(use_task));
+      backoff_.expires_at(std::min(give_up, now + delay));
+      co_await backoff_.async_wait(boost::asio::as_tuple(use_task));
       delay = std::min(policy_.max_delay, delay * 2);
     }
   }
@@ -944,7 +981,8 @@ class basic_client {
   Stream stream_;
   client_options opt_;
   strand_type strand_;
-  timer_type timer_;
+  timer_type timer_;             // the exchanges' deadlines (see arm)
+  timer_type backoff_;           // reconnect's pauses
   std::mutex m_;                 // guards queue_, busy_, closing_, idle_
   detail::fifo<pending> queue_;  // requests waiting for the line
   bool busy_ = false;            // a worker or a calling thread owns the line
@@ -959,7 +997,13 @@ class basic_client {
   [[no_unique_address]] typename detail::protocol_of<Stream>::type protocol_{};  // a parked socket's
   std::function<void(Stream&, std::error_code&)> reopen_;
   reconnect_policy policy_;
-  std::uint64_t generation_ = 0;
+  // The deadline watch: touched only on the strand (by the worker and the timer's completions).
+  std::shared_ptr<deadline_watch> watch_ = std::make_shared<deadline_watch>(deadline_watch{this});
+  clock::time_point deadline_{};    // the running exchange's deadline
+  bool guarding_ = false;           // an exchange runs under deadline_
+  bool waiting_ = false;            // a wait is outstanding on timer_ ...
+  clock::time_point wait_until_{};  // ... until then
+  std::uint64_t generation_ = 0;    // that wait's number: completions of replaced waits are stale
   boost::asio::cancellation_signal cancel_;
   client_counters counters_;
 };
