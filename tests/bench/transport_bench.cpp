@@ -71,7 +71,7 @@ double ratio(const std::vector<double>& a, const std::vector<double>& b) {
 void exchanges(const char* name, const command& cmd, t::basic_client<t::serial_port>& c, const std::string& echo_path,
                const std::string& raw_path) {
   const auto frame = encode(cmd);
-  const std::vector<std::uint8_t> request(frame.bytes().begin(), frame.bytes().end());
+  const auto request = frame.bytes();
   const auto rep = expected_reply(cmd).frame_size();
   const std::vector<std::uint8_t> echoed(std::max(request.size(), rep), 0x55);
   for (int i = 0; i < 200; ++i) c.execute(cmd);  // warm up
@@ -100,7 +100,8 @@ void exchanges(const char* name, const command& cmd, t::basic_client<t::serial_p
 /** Pings by the async API (a callback chain) against a bare Asio coroutine loop. */
 void async_pings(t::basic_client<t::serial_port>& c, const std::string& echo_path, const std::string& raw_path) {
   const auto ping_frame = encode(ping{});
-  const std::vector<std::uint8_t> ping_bytes(ping_frame.bytes().begin(), ping_frame.bytes().end());
+  const auto ping_bytes = ping_frame.bytes();
+  const auto ping_reply = expected_reply(ping{}).frame_size();
   const int per_round = 1000, rounds = 15;
   std::size_t allocs = 0;
   const auto chain = [&] {
@@ -125,8 +126,8 @@ void async_pings(t::basic_client<t::serial_port>& c, const std::string& echo_pat
   chain();  // warm up
   allocs = 0;
   const auto us =
-      take_turns({[&] { return rcb4::testing::pty_round_trips(echo_path, ping_bytes, 4, per_round); },
-                  [&] { return rcb4::testing::asio_round_trips(raw_path, ping_bytes, 4, per_round); }, chain},
+      take_turns({[&] { return rcb4::testing::pty_round_trips(echo_path, ping_bytes, ping_reply, per_round); },
+                  [&] { return rcb4::testing::asio_round_trips(raw_path, ping_bytes, ping_reply, per_round); }, chain},
                  rounds);
   const double client = median(us[2]);
   std::printf(
