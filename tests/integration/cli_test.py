@@ -206,6 +206,9 @@ check(bytes.fromhex("09 00 02 00 04 00 AA BB 74") in s.frames, "stand-in receive
 expect_ok(["--device", s.path, "--baud", "1250000", "read", "ram", "0x0400", "2"], "AA BB")
 rc, out, err = run("doctor", "--device", s.path)
 check("[ ok ] board answers at" in out, "doctor --device: the board check passes")
+if os.access("/dev/cpu_dma_latency", os.R_OK):
+    check("[ -- ] CPU wake-up latency:" in out and "[FAIL] CPU" not in out,
+          "doctor notes the CPU wake-up latency bound (a note, not a failure)")
 
 silent = StandIn(silent=True)
 t0 = time.monotonic()
