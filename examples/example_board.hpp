@@ -33,9 +33,9 @@ struct connection {
       path = server->where();
       std::printf("(no device given: using a virtual RCB-4 on %s)\n", path.c_str());
     }
-    std::error_code ec;
+    rcb4::transport::error_code ec;
     const auto baud = rcb4::transport::detect_baud(io.context(), path, ec);  // 1250000, 115200 or 625000
-    if (ec) throw std::system_error(ec, path);
+    if (ec) throw rcb4::transport::system_error(ec, path);
     rcb4::transport::client_options opt;
     opt.baud = baud;
     client = std::make_unique<rcb4::transport::basic_client<rcb4::transport::serial_port>>(

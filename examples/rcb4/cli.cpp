@@ -108,9 +108,12 @@ session::session(const globals& g) {
   if (g.baud) {
     baud = *g.baud;
   } else {
-    std::error_code ec;
-    baud = rcb4::transport::detect_baud(io_.context(), path, ec, std::max(g.timeout, std::chrono::milliseconds(50)));
-    if (ec) throw std::system_error(ec, path);
+    rcb4::transport::detect_options how;
+    how.turnaround = std::max(g.timeout, std::chrono::milliseconds(50));
+    how.trace = opt.trace;  // --trace shows the detection's frames too
+    rcb4::transport::error_code ec;
+    baud = rcb4::transport::detect_baud(io_.context(), path, ec, how);
+    if (ec) throw rcb4::transport::system_error(ec, path);
   }
   auto port = rcb4::transport::open_serial(io_.context(), path, baud);
   opt.baud = baud;

@@ -84,7 +84,7 @@ class session {
   bool is_serial() const noexcept { return serial_; }
   /** True when no --device was given. */
   bool is_virtual() const noexcept { return board_ != nullptr; }
-  /** Runs @p op, throwing std::system_error on failure. */
+  /** Runs @p op, throwing rcb4::transport::system_error on failure. */
   template <rcb4::ops::Operation Op>
   auto run(Op op) {
     return rcb4::transport::run(*client_, std::move(op));

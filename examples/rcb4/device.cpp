@@ -139,9 +139,9 @@ int ping_cmd(session& s, const parsed& p, const globals& g) {
 int version_cmd(session& s, const parsed& p, const globals& g) {
   no_more(p, 0);
   rcb4::ops::read_version op;
-  std::error_code ec;
+  rcb4::transport::error_code ec;
   rcb4::transport::run(s.c(), op, ec);
-  if (ec) throw std::system_error(ec, "version");
+  if (ec) throw rcb4::transport::system_error(ec, "version");
   const auto& v = op.value();
   if (g.json)
     fmt::print("{{\"version\":\"{}\",\"raw\":{}}}\n", v, json_bytes(op.raw()));
@@ -522,7 +522,7 @@ int wait_motion(session& s, const parsed& p, const globals& g, const rcb4::rom_l
   const auto timeout = seconds_option(p, "--timeout", 60);
   const bool tty = ::isatty(STDERR_FILENO) && !g.json;
   const auto start = std::chrono::steady_clock::now();
-  std::error_code ec;
+  rcb4::transport::error_code ec;
   const auto st = rcb4::transport::wait_motion(
       s.c(), timeout, ec,
       [&](const rcb4::ops::motion_state& m) {
@@ -533,7 +533,7 @@ int wait_motion(session& s, const parsed& p, const globals& g, const rcb4::rom_l
       },
       layout);
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
-  if (ec) throw std::system_error(ec, "motion wait");
+  if (ec) throw rcb4::transport::system_error(ec, "motion wait");
   const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!g.json) fmt::print("done after {:.1f} s\n", t);
   print_motion(st, g);

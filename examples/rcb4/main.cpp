@@ -43,13 +43,16 @@ int report(std::string_view cmd, const std::system_error& e) {
   namespace t = rcb4::transport;
   int code = cli::exit_io;
   std::string_view hint;
-  if (ec.category() == rcb4::error_category()) {
+  if (ec.category() == rcb4::codec_category()) {
     code = cli::exit_board;
     if (ec == rcb4::errc::nack) hint = "the board refused the command (range, unallocated servo, or a busy program)";
-  } else if (ec == t::errc::timeout || ec == t::errc::no_board) {
+  } else if (ec == t::transport_errc::echo) {
+    code = cli::exit_board;
+    hint = "the line returns what is sent: a loopback plug or an echoing adapter, not an RCB-4";
+  } else if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board) {
     code = cli::exit_timeout;
     hint = "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud, or `rcb4 doctor`";
-  } else if (ec == t::errc::port_busy) {
+  } else if (ec == t::transport_errc::port_busy) {
     hint = "another program has the port open (`fuser -v` on the device shows which)";
   } else if (ec == std::errc::permission_denied) {
     hint = "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)";

@@ -225,7 +225,7 @@ int doctor(const args& a, const globals& g) {
       session s(probe);
       const auto v = s.run(rcb4::ops::read_version{});
       report(true, fmt::format("board answers at {} baud: {}", s.baud(), v));
-    } catch (const std::system_error& e) {
+    } catch (const std::runtime_error& e) {  // std:: or boost::system::system_error
       report(false, fmt::format("no board: {}", e.what()),
              "power the board (battery or supply), check the cable and that the adapter is in RCB-4 (not ICS) mode; "
              "`rcb4 --device PATH --trace ping` shows the bytes");

@@ -48,7 +48,7 @@ enum class errc : std::uint8_t {
   echo_mismatch,     ///< reply CMD byte is not the command that was sent
   bad_ack_code,      ///< 4-byte reply whose status byte is neither 06 (ACK) nor 15 (NACK)
   unexpected_ack,    ///< ACK where a data reply was expected
-  nack,              ///< the board answered NACK (mapped by the transport where an ACK was due)
+  nack,              ///< the board refused (NACK): an error where the caller expected success (execute)
   // operations (rcb4/ops.hpp)
   baud_change_not_allowed,  ///< a config write that changes the COM baud (use ops::switch_baud)
   unsupported_baud,         ///< a COM rate other than 115200, 625000 or 1250000 (protocol.md §9)
@@ -102,8 +102,8 @@ constexpr const char* message(errc e) noexcept {
   return "unknown rcb4 error";
 }
 
-/** The std::error_category of rcb4::errc; its name() is "rcb4". */
-class error_category_impl final : public std::error_category {
+/** The std::error_category of rcb4::errc (the codec's); its name() is "rcb4". */
+class codec_category_impl final : public std::error_category {
  public:
   /** The category name, "rcb4". */
   const char* name() const noexcept override { return "rcb4"; }
@@ -111,14 +111,14 @@ class error_category_impl final : public std::error_category {
   std::string message(int ev) const override { return rcb4::message(static_cast<errc>(ev)); }
 };
 
-/** The single instance of the rcb4 error category. */
-inline const std::error_category& error_category() noexcept {
-  static const error_category_impl instance;
+/** The single instance of the codec's error category. */
+inline const std::error_category& codec_category() noexcept {
+  static const codec_category_impl instance;
   return instance;
 }
 
 /** Makes a std::error_code from @p e (found by ADL for `std::error_code ec = errc::...`). */
-inline std::error_code make_error_code(errc e) noexcept { return {static_cast<int>(e), error_category()}; }
+inline std::error_code make_error_code(errc e) noexcept { return {static_cast<int>(e), codec_category()}; }
 
 }  // namespace rcb4
 

@@ -156,7 +156,7 @@ void control_cycle(const command& write36) {
   auto cs = t::make_client(t::open_serial(spin_io.context(), spin_board.server->where(), 1250000), spin);
   std::size_t wire_bytes = 0;
   ops::read_servo_states probe(cost);
-  std::error_code ec;
+  t::error_code ec;
   t::run(c, probe, ec);
   wire_bytes += 10 + 73;  // the allocation-table read
   for (const auto& r : probe.plan()) wire_bytes += 10 + r.size + 3;

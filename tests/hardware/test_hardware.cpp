@@ -28,7 +28,7 @@ std::string device() {
 /** A client on the device at the rate detect_baud finds. */
 auto open_board(t::io_thread& io) {
   const auto path = device();
-  std::error_code ec;
+  t::error_code ec;
   const auto baud = t::detect_baud(io.context(), path, ec);
   INFO("detect_baud on " << path << ": " << ec.message());
   REQUIRE(baud != 0);
@@ -40,7 +40,7 @@ auto open_board(t::io_thread& io) {
 
 TEST_CASE("hardware: the adapter runs 8E1 raw at the board's rate", "[hardware]") {
   t::io_thread io;
-  std::error_code ec;
+  t::error_code ec;
   const auto baud = t::detect_baud(io.context(), device(), ec);
   REQUIRE(baud != 0);
   t::serial_info info;
@@ -54,7 +54,7 @@ TEST_CASE("hardware: the adapter runs 8E1 raw at the board's rate", "[hardware]"
   CHECK((tio.c_cflag & CSTOPB) == 0);
   CHECK((tio.c_lflag & ICANON) == 0);
   t::open_serial(io.context(), device(), baud, ec);  // exclusive
-  CHECK(ec == t::errc::port_busy);
+  CHECK(ec == t::transport_errc::port_busy);
   if (info.latency_timer_ms) WARN("FTDI latency timer: " << *info.latency_timer_ms << " ms");
 }
 

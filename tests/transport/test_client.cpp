@@ -35,7 +35,6 @@ using rcb4::testing::served_board;
 static_assert(t::AsyncByteStream<boost::asio::serial_port>);
 static_assert(t::AsyncByteStream<boost::asio::ip::tcp::socket>);
 static_assert(t::AsyncByteStream<boost::asio::posix::stream_descriptor>);
-static_assert(t::SyncByteStream<boost::asio::serial_port>);
 static_assert(!t::AsyncByteStream<int>);
 static_assert(!t::AsyncByteStream<std::vector<std::uint8_t>>);
 struct read_only {
@@ -74,7 +73,7 @@ bool watched_by_epoll(int fd) {
 
 /** One blocking exchange of @p cmd on @p c (its reply in @p reply, if given); how long it took. */
 template <class Client>
-std::chrono::steady_clock::duration timed_execute(Client& c, const command& cmd, std::error_code& ec,
+std::chrono::steady_clock::duration timed_execute(Client& c, const command& cmd, t::error_code& ec,
                                                   t::response* reply = nullptr) {
   const auto start = std::chrono::steady_clock::now();
   auto r = c.execute(cmd, ec);
@@ -95,11 +94,11 @@ TEST_CASE("client: sync execute against the virtual board", "[transport]") {
   const auto r = c.execute(move::read_ram(0x0400, 3).value());
   CHECK(r.data.size() == 3);
   CHECK(r.data[2] == 3);
-  std::error_code ec;
+  t::error_code ec;
   const auto n = c.execute(single_servo{30, 7500, 10}, ec);  // unallocated slot
   CHECK(ec == rcb4::errc::nack);
   CHECK(n.kind == reply_kind::nack);
-  CHECK_THROWS_AS(c.execute(single_servo{30, 7500, 10}), std::system_error);
+  CHECK_THROWS_AS(c.execute(single_servo{30, 7500, 10}), t::system_error);
   CHECK(c.counters().exchanges == 6);
 }
 
@@ -185,7 +184,7 @@ TEST_CASE("board_server: a paced reply never comes before the wire would have ca
   const auto wire = t::wire_time(10 + 131, 1250000);      // the board's boot rate
   for (int i = 0; i < 20; ++i) {
     c.options().busy_poll = i % 2 ? 200us : 0us;  // the client's wait, sleeping or polling, changes nothing here
-    std::error_code ec;
+    t::error_code ec;
     t::response r;
     CHECK(timed_execute(c, read, ec, &r) >= wire);  // a lower bound the pacer guarantees
     CHECK_FALSE(ec);
@@ -197,9 +196,9 @@ TEST_CASE("client: callback, future, coroutine and deferred completions", "[tran
   served_board b;
   t::io_thread io;
   auto c = open_client(io, b.server->where());
-  std::promise<std::error_code> p;
+  std::promise<t::error_code> p;
   c.async_execute(ping{}, [&p](boost::system::error_code ec, t::response) { p.set_value(ec); });
-  CHECK(p.get_future().get() == std::error_code{});
+  CHECK(p.get_future().get() == t::error_code{});
   // use_future: the error arrives as an exception, the response as the value.
   auto f = c.async_execute(version{}, boost::asio::use_future);
   CHECK(f.get().data.size() == 32);
@@ -229,14 +228,14 @@ TEST_CASE("client: a silent board times out within the deadline", "[transport]")
   opt.busy_poll = GENERATE(0us, 300us);   // a busy-polling wait still ends at the deadline
   INFO("direct_io " << opt.direct_io << ", busy_poll " << opt.busy_poll.count() << " us");
   auto c = open_client(io, silent.path(), opt);
-  std::error_code ec;
+  t::error_code ec;
   const auto took = timed_execute(c, ping{}, ec);
-  CHECK(ec == t::errc::timeout);
+  CHECK(ec == t::transport_errc::timeout);
   CHECK(c.counters().timeouts == 3);  // a ping is idempotent: 1 + 2 retries
   CHECK(c.counters().retries == 2);
   CHECK(took < 2s);                          // a hang check, not a speed target: 3 × (20 ms + wire time)
   c.execute(single_servo{0, 7500, 10}, ec);  // a write is not retried
-  CHECK(ec == t::errc::timeout);
+  CHECK(ec == t::transport_errc::timeout);
   CHECK(c.counters().timeouts == 4);
 }
 
@@ -257,9 +256,9 @@ TEST_CASE("client: a deadline earlier than the previous exchange's still holds",
   CHECK(c.execute(ping{}).kind == reply_kind::ack);  // leaves a wait outstanding until ~30 s from now
   c.options().turnaround = 20ms;
   silent = true;
-  std::error_code ec;
+  t::error_code ec;
   const auto took = timed_execute(c, ping{}, ec);
-  CHECK(ec == t::errc::timeout);
+  CHECK(ec == t::transport_errc::timeout);
   CHECK(c.counters().timeouts == 3);
   CHECK(took < 2s);  // a hang check: 3 × (20 ms + wire time), where the stale wait would take 30 s
   silent = false;
@@ -273,9 +272,9 @@ TEST_CASE("client: on a tty, a wait of whole tenths blocks in read() and still e
   opt.turnaround = 250ms;  // two tenths in a bounded read (the terminal's own timer), the rest in ppoll
   opt.read_retries = 0;
   auto c = open_client(io, silent.path(), opt);
-  std::error_code ec;
+  t::error_code ec;
   const auto took = timed_execute(c, ping{}, ec);
-  CHECK(ec == t::errc::timeout);
+  CHECK(ec == t::transport_errc::timeout);
   CHECK(took >= 250ms);  // not before the deadline
   CHECK(took < 2s);      // a hang check, not a speed target
 }
@@ -305,7 +304,7 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
   for (int m : {1, 2, 3, 5}) {
     INFO("fault mode " << m);
     mode = m;
-    std::error_code ec;
+    t::error_code ec;
     const auto r = c.execute(read, ec);
     if (!ec)
       CHECK(r.u16() == 0x03FF);  // if anything is accepted, it is the right value
@@ -337,9 +336,9 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
   for (int m : {3, 4}) {
     INFO("timing mode " << m);
     timing = m;
-    std::error_code ec;
+    t::error_code ec;
     c2.execute(read, ec);
-    CHECK(ec == t::errc::timeout);
+    CHECK(ec == t::transport_errc::timeout);
     timing = 0;
     // The late PIO reply has the same shape as the config reply: it must never be taken for it.
     // (The exchange right after may itself time out while the line resynchronises.)
@@ -379,15 +378,15 @@ TEST_CASE("client: 8 threads, every reply reaches its caller", "[transport][thre
         const std::uint8_t bytes[] = {static_cast<std::uint8_t>(v & 0xFF), static_cast<std::uint8_t>(v >> 8)};
         // Even threads block (their exchanges run on their own thread when the line is idle);
         // odd threads use the async API (queued for the executor's worker): the two interleave.
-        const auto exchange = [&](const command& cmd, std::error_code& ec) {
+        const auto exchange = [&](const command& cmd, t::error_code& ec) {
           if (k % 2 == 0) return c.execute(cmd, ec);
-          std::promise<std::pair<std::error_code, t::response>> done;
+          std::promise<std::pair<t::error_code, t::response>> done;
           c.async_execute(cmd, [&done](boost::system::error_code e, t::response r) { done.set_value({e, r}); });
           auto [e, r] = done.get_future().get();
           ec = e;
           return r;
         };
-        std::error_code ec;
+        t::error_code ec;
         if (i % 2 == 0) {
           exchange(move::write_ram(addr, bytes).value(), ec);
         } else {
@@ -419,7 +418,7 @@ TEST_CASE("client: destroying a client with exchanges in flight ends them, no ha
   const auto e1 = first.get_future().get();
   const auto e2 = second.get_future().get();
   CHECK(e1);
-  CHECK(std::error_code(e2) == t::errc::cancelled);
+  CHECK(e2 == t::transport_errc::cancelled);
   CHECK(std::chrono::steady_clock::now() - start < 5s);
 }
 
@@ -445,7 +444,7 @@ TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[
                           "/log 2>&1 & echo $! > " + dir + "/child";
   REQUIRE(std::system(cmd.c_str()) == 0);
   t::io_thread io;
-  std::error_code ec;
+  t::error_code ec;
   t::tcp_socket s(io.context());
   for (int i = 0; i < 100; ++i) {  // ser2net needs a moment to listen; bounded
     s = t::connect(io.context(), "127.0.0.1:" + std::to_string(port), ec);
@@ -464,14 +463,14 @@ TEST_CASE("client: TCP through Debian's ser2net bridging to the board's pty", "[
                "/child); kill $p 2>/dev/null; for i in $(seq 100); do kill -0 $p 2>/dev/null || break; " +
                "sleep 0.02; done")
                   .c_str());
-  std::error_code rm;
+  t::error_code rm;
   std::filesystem::remove_all(dir, rm);
 }
 
 TEST_CASE("client: operations run on the client, baud detection, bad addresses", "[transport]") {
   served_board b;
   t::io_thread io;
-  std::error_code ec;
+  t::error_code ec;
   CHECK(t::detect_baud(io.context(), b.server->where(), ec) == 1250000);  // a pty answers at the first rate
   CHECK_FALSE(ec);
   CHECK(t::detect_baud(io.context(), "/dev/does-not-exist", ec) == 0);
@@ -509,9 +508,9 @@ TEST_CASE("open_serial: 8E1, raw, the rate read back, exclusive, and clear error
   CHECK((tio.c_lflag & (ICANON | ECHO | ISIG)) == 0);  // raw
   CHECK((tio.c_oflag & OPOST) == 0);
   CHECK(tio.c_cc[VMIN] == 1);  // an empty non-blocking read is EAGAIN, not an end of file
-  std::error_code ec;
+  t::error_code ec;
   t::open_serial(io.context(), b.server->where(), 625000, ec);  // a second opener
-  CHECK(ec == t::errc::port_busy);
+  CHECK(ec == t::transport_errc::port_busy);
   t::open_serial(io.context(), "/dev/null", 115200, ec);  // not a terminal
   CHECK(ec == std::errc::inappropriate_io_control_operation);
   t::open_serial(io.context(), "/dev/does-not-exist", 115200, ec);

@@ -23,15 +23,15 @@ TEST_CASE("reconnect: a lost link is reopened with backoff and a read is retried
   t::basic_client<fake_stream> c(fake_stream(io.context().get_executor(), b, 1, boost::asio::error::eof), opt);
   int attempts = 0;
   c.set_reconnect(
-      [&](fake_stream& s, std::error_code& ec) {
+      [&](fake_stream& s, t::error_code& ec) {
         if (++attempts < 3) {
-          ec = std::make_error_code(std::errc::no_such_device);  // still unplugged
+          ec = t::os_error(ENODEV);  // still unplugged
           return;
         }
         s = fake_stream(io.context().get_executor(), b);
       },
       {1ms, 4ms, 2s});
-  std::error_code ec;
+  t::error_code ec;
   const auto r = c.execute(ping{}, ec);
   CHECK_FALSE(ec);
   CHECK(r.kind == reply_kind::ack);
@@ -44,10 +44,10 @@ TEST_CASE("reconnect: a write that meets the loss fails, the next exchange recon
   board::virtual_board b;
   t::io_thread io;
   t::basic_client<fake_stream> c(fake_stream(io.context().get_executor(), b, 1, boost::asio::error::eof));
-  c.set_reconnect([&](fake_stream& s, std::error_code&) { s = fake_stream(io.context().get_executor(), b); });
-  std::error_code ec;
+  c.set_reconnect([&](fake_stream& s, t::error_code&) { s = fake_stream(io.context().get_executor(), b); });
+  t::error_code ec;
   c.execute(single_servo{0, 8000, 0}, ec);
-  CHECK(ec == t::errc::closed);  // not repeated: it may or may not have reached the board
+  CHECK(ec == t::transport_errc::closed);  // not repeated: it may or may not have reached the board
   CHECK(c.counters().reconnects == 0);
   CHECK(c.execute(single_servo{0, 8000, 0}).kind == reply_kind::ack);
   CHECK(c.counters().reconnects == 1);
@@ -60,18 +60,18 @@ TEST_CASE("reconnect: a link that stays lost ends with reconnect_failed, every c
   t::basic_client<fake_stream> c(fake_stream(io.context().get_executor(), b, 1, boost::asio::error::eof));
   int attempts = 0;
   c.set_reconnect(
-      [&](fake_stream&, std::error_code& ec) {
+      [&](fake_stream&, t::error_code& ec) {
         ++attempts;
-        ec = std::make_error_code(std::errc::no_such_device);
+        ec = t::os_error(ENODEV);
       },
       {1ms, 8ms, 100ms});
-  std::error_code ec;
+  t::error_code ec;
   c.execute(ping{}, ec);
-  CHECK(ec == t::errc::reconnect_failed);
+  CHECK(ec == t::transport_errc::reconnect_failed);
   CHECK(attempts >= 2);
   const int first = attempts;
   c.execute(ping{}, ec);  // the next exchange tries again
-  CHECK(ec == t::errc::reconnect_failed);
+  CHECK(ec == t::transport_errc::reconnect_failed);
   CHECK(attempts > first);
 }
 
@@ -86,14 +86,14 @@ TEST_CASE("reconnect: a pty whose board went away, then came back", "[transport]
   CHECK(c.execute(ping{}).kind == reply_kind::ack);
 
   first.reset();  // the board is gone: the pty's other side is closed
-  std::error_code ec;
+  t::error_code ec;
   c.execute(ping{}, ec);
   INFO(ec.message());
   CHECK(t::is_link_lost(ec));  // EIO on a pty (a USB adapter gives EIO or EOF alike)
 
   rcb4::testing::served_board second;
   path = second.server->where();
-  c.set_reconnect([&](t::serial_port& s, std::error_code& e) { s = t::open_serial(io.context(), path, 1250000, e); });
+  c.set_reconnect([&](t::serial_port& s, t::error_code& e) { s = t::open_serial(io.context(), path, 1250000, e); });
   CHECK(c.execute(ping{}).kind == reply_kind::ack);
   CHECK(c.counters().reconnects == 1);
 }
@@ -110,7 +110,7 @@ TEST_CASE("switch_baud: the board and the host move to the new rate together", "
   t::switch_baud(c, 115200);
   CHECK(c.options().baud == 115200);
   CHECK(t::run(c, ops::read_config{}).com_baud == baud_code::b115200);
-  std::error_code ec;
+  t::error_code ec;
   t::switch_baud(c, 9600, ec);
   CHECK(ec == rcb4::errc::unsupported_baud);
   CHECK(t::run(c, ops::read_config{}).com_baud == baud_code::b115200);
@@ -123,9 +123,9 @@ TEST_CASE("wait_motion: returns when the motion ends, or at its deadline", "[tra
   t::io_thread io;
   auto c = t::make_client(t::open_serial(io.context(), sb.server->where(), 1250000));
   t::run(c, ops::play_motion(2));
-  std::error_code ec;
+  t::error_code ec;
   auto st = t::wait_motion(c, 50ms, ec);  // motion 2 takes about 1.5 s
-  CHECK(ec == t::errc::timeout);
+  CHECK(ec == t::transport_errc::timeout);
   CHECK(st.running);
   int progress_calls = 0;
   st = t::wait_motion(c, 10s, ec, [&](const ops::motion_state& s) {

@@ -17,49 +17,53 @@
 #include <unistd.h>
 
 #include <functional>
+#include <thread>
 
 namespace rcb4::transport {
 
-/** Runs @p op to the end on @p c; a failed exchange or a refused step sets @p ec. */
+/**
+ * Runs @p op to the end on @p c; a failed exchange or a refused step sets @p ec. Replies reach
+ * the operation as the board sent them (basic_client::exchange): a NACK is the operation's to
+ * judge, never an error first.
+ */
 template <AsyncByteStream Stream, ops::Operation Op>
-Op& run(basic_client<Stream>& c, Op& op, std::error_code& ec) {
+Op& run(basic_client<Stream>& c, Op& op, error_code& ec) {
   ec.clear();
   while (auto cmd = op.next()) {
-    const response r = c.execute(*cmd, ec);
-    if (ec && std::error_code(ec) != rcb4::errc::nack) return op;  // the line failed
-    ec.clear();
-    op.on_reply(r.view());  // a NACK is the operation's to judge
+    const response r = c.exchange(*cmd, ec);
+    if (ec) return op;  // the line failed, or the reply was malformed
+    op.on_reply(r.view());
   }
   if (op.error() != rcb4::errc{}) ec = op.error();
   return op;
 }
 
-/** Runs @p op (taken by value) and returns its value; throws std::system_error on failure. */
+/** Runs @p op (taken by value) and returns its value; throws system_error on failure. */
 template <AsyncByteStream Stream, ops::Operation Op>
 auto run(basic_client<Stream>& c, Op op) {
-  std::error_code ec;
+  error_code ec;
   run(c, op, ec);
-  if (ec) throw std::system_error(ec, "rcb4 operation");
+  if (ec) throw system_error(ec, "rcb4 operation");
   return op.value();
 }
 
 namespace detail {
 /** Runs @p op to the end in a coroutine; the error of the line or of the operation, if any. */
 template <AsyncByteStream Stream, ops::Operation Op>
-boost::asio::awaitable<std::error_code> async_run_ec(basic_client<Stream>& c, Op& op) {
+boost::asio::awaitable<error_code> async_run_ec(basic_client<Stream>& c, Op& op) {
   while (auto cmd = op.next()) {
-    auto [ec, r] = co_await c.async_execute(*cmd, boost::asio::as_tuple(boost::asio::use_awaitable));
-    if (ec && std::error_code(ec) != rcb4::errc::nack) co_return std::error_code(ec);  // the line failed
+    auto [ec, r] = co_await c.async_exchange(*cmd, boost::asio::as_tuple(boost::asio::use_awaitable));
+    if (ec) co_return ec;   // the line failed, or the reply was malformed
     op.on_reply(r.view());  // a NACK is the operation's to judge
   }
-  co_return op.error() != rcb4::errc{} ? std::error_code(op.error()) : std::error_code{};
+  co_return op.error() != rcb4::errc{} ? error_code(op.error()) : error_code{};
 }
 }  // namespace detail
 
 /** Coroutine form: co_await async_run(client, op) → the operation's value; throws on failure. */
 template <AsyncByteStream Stream, ops::Operation Op>
 boost::asio::awaitable<std::decay_t<decltype(std::declval<Op&>().value())>> async_run(basic_client<Stream>& c, Op op) {
-  if (const auto ec = co_await detail::async_run_ec(c, op)) throw std::system_error(ec, "rcb4 operation");
+  if (const auto ec = co_await detail::async_run_ec(c, op)) throw system_error(ec, "rcb4 operation");
   co_return op.value();
 }
 
@@ -72,7 +76,7 @@ boost::asio::awaitable<std::decay_t<decltype(std::declval<Op&>().value())>> asyn
  * other thread uses the client. The change is RAM-only: a power cycle restores the ROM rate.
  */
 template <AsyncByteStream Stream>
-void switch_baud(basic_client<Stream>& c, std::uint32_t bps, std::error_code& ec) {
+void switch_baud(basic_client<Stream>& c, std::uint32_t bps, error_code& ec) {
   auto op = ops::switch_baud(bps);
   run(c, op, ec);
   if (ec) return;
@@ -80,8 +84,8 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps, std::error_code& ec
     const int fd = c.stream().native_handle();
     if (::isatty(fd)) {  // a serial port (also when wrapped as a plain descriptor); not a socket
       const auto got = detail::set_custom_baud(fd, bps);
-      if (!got || (*got > bps ? *got - bps : bps - *got) > bps / 50) {
-        ec = errc::unsupported_baud;  // the board moved but this port cannot follow
+      if (!got || !detail::rate_close(*got, bps)) {
+        ec = transport_errc::rate_not_set;  // the board moved but this port cannot follow
         return;
       }
     }
@@ -90,12 +94,12 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps, std::error_code& ec
   c.execute(ping{}, ec);
 }
 
-/** switch_baud that throws std::system_error. */
+/** switch_baud that throws system_error. */
 template <AsyncByteStream Stream>
 void switch_baud(basic_client<Stream>& c, std::uint32_t bps) {
-  std::error_code ec;
+  error_code ec;
   switch_baud(c, bps, ec);
-  if (ec) throw std::system_error(ec, "rcb4 switch baud");
+  if (ec) throw system_error(ec, "rcb4 switch baud");
 }
 
 /** Called with each motion state wait_motion reads (for a progress display). */
@@ -106,7 +110,7 @@ inline constexpr std::chrono::milliseconds motion_poll{50};
 
 namespace detail {
 template <AsyncByteStream Stream>
-boost::asio::awaitable<std::pair<std::error_code, ops::motion_state>> wait_motion(
+boost::asio::awaitable<std::pair<error_code, ops::motion_state>> wait_motion(
     basic_client<Stream>& c, std::chrono::steady_clock::duration timeout, motion_progress progress, rom_layout layout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   boost::asio::steady_timer timer(co_await boost::asio::this_coro::executor);
@@ -114,9 +118,9 @@ boost::asio::awaitable<std::pair<std::error_code, ops::motion_state>> wait_motio
     ops::read_motion_state op(layout);
     if (const auto ec = co_await async_run_ec(c, op)) co_return std::pair{ec, op.value()};
     if (progress) progress(op.value());
-    if (!op.value().running) co_return std::pair{std::error_code{}, op.value()};
+    if (!op.value().running) co_return std::pair{error_code{}, op.value()};
     const auto now = std::chrono::steady_clock::now();
-    if (now >= deadline) co_return std::pair{std::error_code(errc::timeout), op.value()};
+    if (now >= deadline) co_return std::pair{error_code(transport_errc::timeout), op.value()};
     timer.expires_at(std::min(deadline, now + motion_poll));
     co_await timer.async_wait(boost::asio::as_tuple(boost::asio::use_awaitable));
   }
@@ -125,7 +129,7 @@ boost::asio::awaitable<std::pair<std::error_code, ops::motion_state>> wait_motio
 
 /**
  * Coroutine: reads the motion state every 50 ms until no motion runs, and returns the last state.
- * Throws std::system_error with errc::timeout when a motion still runs after @p timeout.
+ * Throws system_error with transport_errc::timeout when a motion still runs after @p timeout.
  */
 template <AsyncByteStream Stream>
 boost::asio::awaitable<ops::motion_state> async_wait_motion(basic_client<Stream>& c,
@@ -133,22 +137,31 @@ boost::asio::awaitable<ops::motion_state> async_wait_motion(basic_client<Stream>
                                                             motion_progress progress = {},
                                                             const rom_layout& layout = hth4_2_2) {
   auto [ec, st] = co_await detail::wait_motion(c, timeout, std::move(progress), layout);
-  if (ec) throw std::system_error(ec, "rcb4 wait for motion");
+  if (ec) throw system_error(ec, "rcb4 wait for motion");
   co_return st;
 }
 
 /**
- * Blocking: waits until no motion runs or @p timeout passes (then @p ec is errc::timeout and the
- * state still says running). The client's executor must run on another thread (io_thread).
+ * Blocking: reads the motion state every 50 ms on this thread until no motion runs, or
+ * @p timeout passes (then @p ec is transport_errc::timeout and the state still says running).
  */
 template <AsyncByteStream Stream>
-ops::motion_state wait_motion(basic_client<Stream>& c, std::chrono::steady_clock::duration timeout, std::error_code& ec,
+ops::motion_state wait_motion(basic_client<Stream>& c, std::chrono::steady_clock::duration timeout, error_code& ec,
                               motion_progress progress = {}, const rom_layout& layout = hth4_2_2) {
-  auto f = boost::asio::co_spawn(c.get_executor(), detail::wait_motion(c, timeout, std::move(progress), layout),
-                                 boost::asio::use_future);
-  auto [e, st] = f.get();
-  ec = e;
-  return st;
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  for (;;) {
+    ops::read_motion_state op(layout);
+    run(c, op, ec);
+    if (ec) return op.value();
+    if (progress) progress(op.value());
+    if (!op.value().running) return op.value();
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= deadline) {
+      ec = transport_errc::timeout;
+      return op.value();
+    }
+    std::this_thread::sleep_until(std::min(deadline, now + motion_poll));  // the board's own refresh period
+  }
 }
 
 }  // namespace rcb4::transport

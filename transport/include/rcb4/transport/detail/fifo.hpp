@@ -43,6 +43,25 @@ class fifo {
     --count_;
     return v;
   }
+  /** Removes and returns the first element for which @p pred is true, if any (order kept). */
+  template <class Pred>
+  std::optional<T> take_if(Pred pred) {
+    for (std::size_t i = 0; i < count_; ++i) {
+      auto& slot = slots_[(head_ + i) % slots_.size()];
+      if (!pred(*slot)) continue;
+      std::optional<T> out(std::move(*slot));
+      for (std::size_t j = i; j + 1 < count_; ++j) {  // close the gap: later elements move up
+        auto& to = slots_[(head_ + j) % slots_.size()];
+        auto& from = slots_[(head_ + j + 1) % slots_.size()];
+        to.reset();
+        to.emplace(std::move(*from));
+      }
+      slots_[(head_ + count_ - 1) % slots_.size()].reset();
+      --count_;
+      return out;
+    }
+    return std::nullopt;
+  }
 
  private:
   void grow_if_full() {

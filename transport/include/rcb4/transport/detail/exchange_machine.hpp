@@ -1,0 +1,366 @@
+// rcb4 — the whole policy of one exchange and of the line, as a sans-I/O state machine.
+// SPDX-License-Identifier: BSL-1.0
+//
+// The machine never touches a stream or reads a clock. A driver (the Asio worker, the POSIX
+// caller-thread driver, a test) asks it what to do and tells it how that went, with the time:
+//
+//   auto a = m.start(req, now, stray_bytes);
+//   while (a.what != action::kind::done) {
+//     io_result r = perform(a);           // write a.out / read into a.in before a.deadline /
+//     a = m.resume(r, now());             // reopen the link, not before a.deadline
+//   }
+//   complete(a.ec, m.reply());
+//
+// What it decides (DESIGN.md §4, §8):
+// - one attempt = write the frame, then read exactly what the reply can still hold (the first
+//   byte is its length, so the next reply is never eaten), all before the attempt's deadline:
+//   the wire time of request and reply (11 bits a byte at 8E1, protocol.md §1) plus the
+//   turnaround allowance;
+// - after any error (timeout, a malformed reply, stray bytes, a cancelled exchange) the line is
+//   dirty, and the next attempt first resynchronises: it sends a ping (03 FE 01) and discards everything up
+//   to its ACK (the board answers in order, so a late or split reply cannot be taken for the next
+//   one), then the line must stay quiet for `quiet`;
+// - idempotent requests (ping, VERSION, MOV → COM) get `read_retries` more attempts, writes none
+//   unless `retry_writes`;
+// - a lost link (EOF, EIO, ENODEV ...) is reopened before the next attempt when the client can
+//   reopen it, with a backoff from `first_delay` doubling to `max_delay`, for `give_up_after`;
+// - a reply that is the request's own bytes coming back is a loopback, not a board.
+// A well-formed reply ends the exchange without error, a NACK included: the client decides what
+// a NACK means for its caller (see basic_client::execute and exchange).
+#pragma once
+
+#include <rcb4/rcb4.hpp>
+#include <rcb4/transport/detail/exchange.hpp>
+#include <rcb4/transport/error.hpp>
+#include <rcb4/transport/options.hpp>
+#include <rcb4/transport/response.hpp>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <optional>
+#include <span>
+
+namespace rcb4::transport::detail {
+
+using clock = std::chrono::steady_clock;
+
+/** What a driver must do next. */
+struct action {
+  /** The kinds of action. */
+  enum class kind : std::uint8_t {
+    write,   ///< write `out` (all of it, or report what was written) before `deadline`
+    read,    ///< read at most `in.size()` bytes into `in` before `deadline` (what arrives first)
+    reopen,  ///< reopen the link, not before `deadline`
+    done,    ///< the exchange has ended with `ec` (the reply is machine.reply())
+  };
+  kind what = kind::done;               ///< what to do
+  std::span<const std::uint8_t> out{};  ///< write: the bytes still to write
+  std::span<std::uint8_t> in{};         ///< read: where the bytes go
+  clock::time_point deadline{};         ///< write/read: give up then; reopen: not before then
+  clock::time_point expected{};         ///< read: when the reply is due on the wire (for busy polling)
+  error_code ec{};                      ///< done: the outcome
+};
+
+/** How the last action ended. */
+struct io_result {
+  std::size_t n = 0;       ///< bytes written or read (also with an error or a timeout)
+  error_code ec{};         ///< the stream's error (end of file included), or the reopen's
+  bool timed_out = false;  ///< the deadline passed first
+};
+
+/** The wire time of @p frame_bytes + @p reply_bytes at @p baud: 11 bits a byte (8E1). */
+inline clock::duration wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / std::max(baud, 1u));
+}
+
+/** The policy of one exchange at a time, and the state of the line between them. */
+class exchange_machine {
+ public:
+  /** A machine using @p opt (read at each start, so changes apply to the next exchange). */
+  exchange_machine(const client_options& opt, client_counters& counters) noexcept : opt_(&opt), n_(&counters) {}
+
+  /** Whether a lost link can be reopened (a reopen function is set), and with which policy. */
+  void set_reopen(bool can, reconnect_policy policy = {}) noexcept {
+    can_reopen_ = can;
+    policy_ = policy;
+  }
+
+  /**
+   * Begins @p r (which must outlive the exchange) at @p now. @p stray: bytes found waiting on
+   * the line before anything was sent (a late or duplicated reply): a resync comes first.
+   */
+  action start(const request& r, clock::time_point now, std::size_t stray = 0) {
+    req_ = &r;
+    attempt_ = 0;
+    attempts_ = 1 + ((r.idempotent || opt_->retry_writes) ? opt_->read_retries : 0);
+    reply_ = response{};
+    telling_ = {};
+    if (stray > 0) dirty_ = true;
+    return begin_attempt(now);
+  }
+
+  /** The last action ended with @p r at @p now: what next. */
+  action resume(const io_result& r, clock::time_point now) {
+    switch (phase_) {
+      case phase::reopen: return reopened(r, now);
+      case phase::sync_write:
+      case phase::write: return written(r, now);
+      case phase::sync_read: return sync_read(r, now);
+      case phase::read: return read(r, now);
+      case phase::idle: break;
+    }
+    return finish(transport_errc::cancelled);  // nothing was running
+  }
+
+  /**
+   * The running exchange is abandoned (its I/O was cancelled, or the client is closing): it ends
+   * with @p ec, and the next one resynchronises first (part of a frame may be on the wire).
+   */
+  action cancel(error_code ec = boost::asio::error::operation_aborted) {
+    if (phase_ == phase::idle) return done(ec);
+    if (phase_ != phase::reopen) dirty_ = true;
+    return finish(ec);
+  }
+
+  /** The reply of an exchange that ended without error (ACK, NACK or data). */
+  const response& reply() const noexcept { return reply_; }
+  /** True while no exchange runs. */
+  bool idle() const noexcept { return phase_ == phase::idle; }
+  /** True when the next exchange will resynchronise first. */
+  bool dirty() const noexcept { return dirty_; }
+  /** True when the link was lost (the next exchange reopens it first, when it can). */
+  bool lost() const noexcept { return lost_; }
+  /** The link was replaced from outside (a new stream): it starts clean. */
+  void replaced() noexcept { dirty_ = lost_ = false; }
+  /** The running attempt's deadline (while an exchange runs). */
+  clock::time_point deadline() const noexcept { return deadline_; }
+
+ private:
+  enum class phase : std::uint8_t { idle, reopen, sync_write, sync_read, write, read };
+  static constexpr std::array<std::uint8_t, 4> ping_ack{0x04, 0xFE, 0x06, 0x08};  // protocol.md §4.11
+  static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
+
+  clock::duration budget(std::size_t bytes) const { return wire_time(bytes, opt_->baud) + opt_->turnaround; }
+  std::size_t request_bytes() const { return req_->frame.size() + req_->shape.frame_size(); }
+
+  void trace(direction d, clock::time_point t, std::span<const std::uint8_t> b) const {
+    if (opt_->trace && !b.empty()) opt_->trace(d, t, b);
+  }
+
+  action done(error_code ec) const {
+    action a;
+    a.ec = ec;
+    return a;
+  }
+  action write(std::span<const std::uint8_t> bytes) const {
+    action a;
+    a.what = action::kind::write;
+    a.out = bytes;
+    a.deadline = deadline_;
+    return a;
+  }
+  action read_into(std::span<std::uint8_t> buf) const {
+    action a;
+    a.what = action::kind::read;
+    a.in = buf;
+    a.deadline = deadline_;
+    a.expected = expected_;
+    return a;
+  }
+  action reopen_at(clock::time_point t) const {
+    action a;
+    a.what = action::kind::reopen;
+    a.deadline = t;
+    return a;
+  }
+
+  action begin_attempt(clock::time_point now) {
+    if (attempt_ > 0) ++n_->retries;
+    if (lost_ && can_reopen_) {  // (without a reopen, the attempt tries the line as it is: the OS says if it is gone)
+      phase_ = phase::reopen;
+      give_up_ = now + policy_.give_up_after;
+      delay_ = policy_.first_delay;
+      return reopen_at(now);
+    }
+    return dirty_ ? begin_sync(now) : begin_exchange(now);
+  }
+
+  action begin_sync(clock::time_point now) {
+    // The short ping (protocol.md §4.11): its ACK differs from its frame, so a loopback plug,
+    // which echoes the frame, can never look like a board answering.
+    static constexpr std::array<std::uint8_t, 3> ping_frame{0x03, 0xFE, 0x01};
+    ++n_->resyncs;
+    phase_ = phase::sync_write;
+    sync_ = sync_state{};
+    deadline_ = now + budget(ping_frame.size() + ping_ack.size());
+    expected_ = now + wire_time(ping_frame.size() + ping_ack.size(), opt_->baud);
+    out_ = ping_frame;
+    trace(direction::tx, now, out_);
+    return write(out_);
+  }
+
+  action begin_exchange(clock::time_point now) {
+    phase_ = phase::write;
+    ex_.emplace(req_->frame.bytes(), req_->shape);
+    deadline_ = now + budget(request_bytes());
+    expected_ = now + wire_time(request_bytes(), opt_->baud);
+    out_ = req_->frame.bytes();
+    trace(direction::tx, now, out_);
+    return write(out_);
+  }
+
+  action reopened(const io_result& r, clock::time_point now) {
+    if (!r.ec) {
+      lost_ = dirty_ = false;
+      ++n_->reconnects;
+      return begin_exchange(now);
+    }
+    if (now >= give_up_) return finish(transport_errc::reconnect_failed);
+    const auto at = std::min(give_up_, now + delay_);
+    delay_ = std::min<clock::duration>(policy_.max_delay, delay_ * 2);
+    return reopen_at(at);
+  }
+
+  action written(const io_result& r, clock::time_point now) {
+    n_->bytes_out += r.n;
+    out_ = out_.subspan(std::min(r.n, out_.size()));
+    if (phase_ == phase::write) ex_->wrote(r.n);
+    if (r.timed_out) return timed_out(now);
+    if (r.ec) return line_failed(r.ec, now);
+    if (!out_.empty()) return write(out_);
+    if (phase_ == phase::sync_write) {
+      phase_ = phase::sync_read;
+      return read_into(junk_);
+    }
+    phase_ = phase::read;
+    return read_into(ex_->read_buffer());
+  }
+
+  action sync_read(const io_result& r, clock::time_point now) {
+    const std::size_t n = std::min(r.n, junk_.size());
+    n_->bytes_in += n;
+    trace(direction::rx, now, std::span(junk_).first(n));
+    for (std::size_t i = 0; i < n; ++i) {
+      std::rotate(sync_.tail.begin(), sync_.tail.begin() + 1, sync_.tail.end());
+      sync_.tail.back() = junk_[i];
+      ++sync_.seen;
+    }
+    if (r.ec && !r.timed_out) return line_failed(r.ec, now);
+    const bool at_ack = sync_.seen >= ping_ack.size() && sync_.tail == ping_ack;
+    if (r.timed_out) {
+      if (at_ack && sync_.synced) {  // the ACK, then silence: the line is clean
+        dirty_ = false;
+        return begin_exchange(now);
+      }
+      return timed_out(now);
+    }
+    if (at_ack) {  // our ACK, unless more bytes follow it within `quiet`
+      sync_.synced = true;
+      deadline_ = now + opt_->quiet;
+    } else if (n > 0 && sync_.synced) {  // more came after an ACK-like tail: read on to the real one
+      sync_.synced = false;
+      if (++sync_.resettled > max_resettles) return timed_out(now);
+      deadline_ = now + budget(2 * ping_ack.size());
+    }
+    return read_into(junk_);
+  }
+
+  action read(const io_result& r, clock::time_point now) {
+    if (r.n > 0) {
+      const auto buf = ex_->read_buffer();
+      const std::size_t n = std::min(r.n, buf.size());
+      n_->bytes_in += n;
+      trace(direction::rx, now, buf.first(n));
+      ex_->received(n);
+    }
+    if (ex_->next() == exchange::step::done) return judge(now);
+    if (r.timed_out) return timed_out(now);
+    if (r.ec) return line_failed(r.ec, now);
+    return read_into(ex_->read_buffer());
+  }
+
+  /** A complete frame arrived: the reply, or a malformed frame (resync, and retry if allowed). */
+  action judge(clock::time_point now) {
+    const auto& p = ex_->result();
+    if (p.status == parse_status::error) {
+      error_code ec = p.error;
+      const auto got = ex_->received_bytes();
+      const auto sent = req_->frame.bytes();
+      if (got.size() >= 2 && got.size() <= sent.size() && std::equal(got.begin(), got.end(), sent.begin())) {
+        dirty_ = true;  // our own bytes came back: a loopback, never a board (and no retry cures that)
+        return finish(transport_errc::echo);
+      }
+      return attempt_failed(ec, now);
+    }
+    reply_ = response::from(p.value);
+    if (reply_.kind == reply_kind::nack) ++n_->nacks;
+    return finish({});
+  }
+
+  action timed_out(clock::time_point now) {
+    ++n_->timeouts;
+    return attempt_failed(transport_errc::timeout, now);
+  }
+
+  /**
+   * The attempt failed in a way another attempt may cure: retry while attempts remain. The
+   * exchange reports the first failure that says more than a timeout (a malformed reply, then
+   * silence while resynchronising, is a line or board problem, not a missing board).
+   */
+  action attempt_failed(error_code ec, clock::time_point now) {
+    dirty_ = true;
+    if (!telling_ || telling_ == transport_errc::timeout) telling_ = ec;
+    if (++attempt_ < attempts_) return begin_attempt(now);
+    return finish(telling_);
+  }
+
+  /** The stream failed: final, unless the link was lost and can be reopened for a retry. */
+  action line_failed(error_code ec, clock::time_point now) {
+    if (ec == boost::asio::error::eof) ec = transport_errc::closed;
+    dirty_ = true;
+    if (!is_link_lost(ec)) return finish(ec);
+    lost_ = true;
+    if (can_reopen_) return attempt_failed(ec, now);
+    return finish(ec);
+  }
+
+  action finish(error_code ec) {
+    phase_ = phase::idle;
+    if (!ec) lost_ = false;  // the line works after all
+    ++n_->exchanges;
+    if (ec) ++n_->errors;
+    return done(ec);
+  }
+
+  struct sync_state {
+    std::array<std::uint8_t, 4> tail{};  // the last 4 bytes seen, newest last
+    std::size_t seen = 0;
+    unsigned resettled = 0;
+    bool synced = false;  // the tail was the ping's ACK
+  };
+
+  const client_options* opt_;
+  client_counters* n_;
+  bool can_reopen_ = false;
+  reconnect_policy policy_{};
+  // the line, between exchanges
+  bool dirty_ = false;
+  bool lost_ = false;
+  // the running exchange
+  phase phase_ = phase::idle;
+  const request* req_ = nullptr;
+  unsigned attempt_ = 0, attempts_ = 1;
+  error_code telling_{};  // the most telling failure of the attempts so far
+  clock::time_point deadline_{}, expected_{};
+  std::span<const std::uint8_t> out_{};
+  std::optional<exchange> ex_;
+  sync_state sync_{};
+  std::array<std::uint8_t, 256> junk_{};
+  clock::time_point give_up_{};
+  clock::duration delay_{};
+  response reply_{};
+};
+
+}  // namespace rcb4::transport::detail
