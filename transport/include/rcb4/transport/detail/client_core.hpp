@@ -130,6 +130,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
       direct_.forget();  // a new descriptor, maybe with the old number
       reopen_(s, ec);
     };
+    policy_ = policy;
     machine_.set_reopen(static_cast<bool>(reopen_), policy);
   }
   /** The stream; while the line is idle a parked descriptor goes back into it first. */
@@ -163,6 +164,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     lock.unlock();
     boost::asio::dispatch(strand_, boost::asio::bind_allocator(asio_.alloc(), [self = this->shared_from_this()] {
                             self->asio_.abort(transport_errc::cancelled);
+                            self->asio_.stop();
                             self->direct_.let_go(self->stream_);  // ends any I/O at once
                           }));
     if (running_here() || executor_stopped()) return;
@@ -194,15 +196,16 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     }
   }
 
+  // (through the strand's copy of the executor: a descriptor's get_executor() is not const)
   bool running_here() const {
-    if constexpr (requires { stream_.get_executor().running_in_this_thread(); })
-      return stream_.get_executor().running_in_this_thread();
+    if constexpr (requires { strand_.get_inner_executor().running_in_this_thread(); })
+      return strand_.get_inner_executor().running_in_this_thread();
     else
       return false;
   }
   bool executor_stopped() const {
-    if constexpr (requires { stream_.get_executor().context().stopped(); })
-      return stream_.get_executor().context().stopped();
+    if constexpr (requires { strand_.get_inner_executor().context().stopped(); })
+      return strand_.get_inner_executor().context().stopped();
     else
       return false;
   }
@@ -222,6 +225,9 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
         std::lock_guard lock(m_);
         worker_started_ = true;
         if (closing_ || queue_.empty()) {
+          // The deadline timer's wait would keep the context busy (io.run() from returning) until
+          // it fired: the line is idle, so it goes.
+          asio_.stop();
           busy_ = worker_started_ = false;
           idle_.notify_all();
           co_return;
@@ -337,11 +343,12 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     ec = s->ec;
     return s->r;
   }
-  /** An upper bound of one exchange: every attempt with its resync, and a reconnect's patience. */
+  /** An upper bound of one exchange: every attempt with its resync, a reconnect's patience, a margin. */
   clock::duration longest_exchange() const {
     const auto attempt =
         2 * (wire_time(128 + max_reply_size, opt_.baud) + opt_.turnaround) + 10 * (opt_.quiet + opt_.turnaround);
-    return (1 + opt_.read_retries) * attempt + reconnect_policy{}.give_up_after + std::chrono::seconds(1);
+    const clock::duration reconnect = reopen_ ? clock::duration(policy_.give_up_after + policy_.max_delay) : clock::duration{};
+    return (1 + opt_.read_retries) * attempt + reconnect + std::chrono::seconds(1);
   }
 
   template <class Handler>
@@ -372,6 +379,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
   asio_type asio_;
   posix_type direct_;
   reopen_function reopen_, worker_reopen_;
+  reconnect_policy policy_{};
   std::mutex m_;  // guards what follows
   std::condition_variable idle_;
   fifo<pending> queue_;
