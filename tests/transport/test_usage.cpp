@@ -61,7 +61,7 @@ TEST_CASE("usage: io.run() on the main thread, then the client goes out of scope
       ++answered;
     });
     io.run();  // returns when both exchanges are done
-  }  // the destructor must not wait for a strand nobody runs any more
+  }            // the destructor must not wait for a strand nobody runs any more
   CHECK(answered == 2);
   CHECK(clock_type::now() - start < 5s);
 }
@@ -155,14 +155,15 @@ TEST_CASE("usage: a pool of threads runs the context, requests come from many th
     std::vector<std::future<void>> senders;
     for (int s = 0; s < 4; ++s)
       senders.push_back(boost::asio::post(pool, boost::asio::use_future([&c, &ok, &failed] {
-        std::vector<std::future<t::response>> replies;
-        for (int i = 0; i < 25; ++i) replies.push_back(c.async_execute(ping{}, boost::asio::use_future));
-        for (auto& r : replies) try {
-            if (r.get().kind == reply_kind::ack) ++ok;
-          } catch (const std::exception&) {
-            ++failed;
-          }
-      })));
+                                            std::vector<std::future<t::response>> replies;
+                                            for (int i = 0; i < 25; ++i)
+                                              replies.push_back(c.async_execute(ping{}, boost::asio::use_future));
+                                            for (auto& r : replies) try {
+                                                if (r.get().kind == reply_kind::ack) ++ok;
+                                              } catch (const std::exception&) {
+                                                ++failed;
+                                              }
+                                          })));
     for (auto& s : senders) s.get();
     // And destroyed with requests still queued from the pool's threads: they end, cancelled.
     for (int i = 0; i < 20; ++i) c.async_execute(ping{}, [](t::error_code, t::response) {});
@@ -212,12 +213,10 @@ TEST_CASE("usage: per-operation cancellation of a queued request and of the one 
   sb.silent = true;
   boost::asio::cancellation_signal on_wire, queued;
   std::promise<t::error_code> first, second, third;
-  c.async_execute(ping{}, boost::asio::bind_cancellation_slot(on_wire.slot(), [&](t::error_code ec, t::response) {
-                    first.set_value(ec);
-                  }));
-  c.async_execute(ping{}, boost::asio::bind_cancellation_slot(queued.slot(), [&](t::error_code ec, t::response) {
-                    second.set_value(ec);
-                  }));
+  c.async_execute(ping{}, boost::asio::bind_cancellation_slot(
+                              on_wire.slot(), [&](t::error_code ec, t::response) { first.set_value(ec); }));
+  c.async_execute(ping{}, boost::asio::bind_cancellation_slot(
+                              queued.slot(), [&](t::error_code ec, t::response) { second.set_value(ec); }));
   c.async_execute(ping{}, [&](t::error_code ec, t::response) { third.set_value(ec); });
   const auto start = clock_type::now();
   // Signals are emitted where their handlers run: on the client's executor.
