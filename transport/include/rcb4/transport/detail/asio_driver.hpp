@@ -14,6 +14,7 @@
 #include <boost/asio/cancellation_signal.hpp>
 #include <boost/asio/detached.hpp>
 #include <boost/asio/posix/descriptor_base.hpp>
+#include <boost/asio/socket_base.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/asio/use_awaitable.hpp>
@@ -93,15 +94,19 @@ class asio_driver {
 
   task<io_result> write_before(Stream& s, const action& a) {
     arm(a.deadline);
-    if constexpr (wraps_descriptor) {
-      // A socket wrapped as a plain descriptor: Asio would write() it (SIGPIPE when the peer has
-      // gone), so it is written here with send(MSG_NOSIGNAL), waiting for room if need be.
-      if (fd_is_socket(s.native_handle())) {
+    if constexpr (has_descriptor) {
+      // A frame is small and the line is idle: written at once with one system call, it needs no
+      // completion round trip through the scheduler (the bare Asio loop pays one per write). A
+      // socket, also one wrapped as a plain descriptor (which Asio would write() with SIGPIPE
+      // when the peer has gone), is written with send(MSG_NOSIGNAL).
+      const int fd = s.native_handle();
+      if (fd >= 0 && prepare(s, fd)) {
         for (;;) {
-          const ssize_t n = write_nosignal(s.native_handle(), true, a.out);
+          const ssize_t n = write_nosignal(fd, fd_socket_, a.out);
           if (n >= 0) co_return finish_io(static_cast<std::size_t>(n), {});
           if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) co_return finish_io(0, os_error(errno));
-          auto [e] = co_await s.async_wait(boost::asio::posix::descriptor_base::wait_write, token());
+          if (errno == EINTR) continue;
+          auto [e] = co_await s.async_wait(wait_write(), token());  // no room yet
           if (e || timed_out_) co_return finish_io(0, e);
         }
       }
@@ -133,16 +138,26 @@ class asio_driver {
     co_return io_result{0, ec};
   }
 
-  static constexpr bool wraps_descriptor =
-      posix_driver<Stream>::has_descriptor && !posix_driver<Stream>::is_socket && requires(Stream & s) {
+  static constexpr bool has_descriptor = posix_driver<Stream>::has_descriptor && requires(Stream & s) {
     s.async_wait(boost::asio::posix::descriptor_base::wait_write, boost::asio::detached);
+    s.native_non_blocking(true);
   };
-  bool fd_is_socket(int fd) {
+  static constexpr auto wait_write() {
+    if constexpr (posix_driver<Stream>::is_socket)
+      return boost::asio::socket_base::wait_write;
+    else
+      return boost::asio::posix::descriptor_base::wait_write;
+  }
+  /** Once per descriptor: non-blocking (so a direct write never blocks), and whether it is a socket. */
+  bool prepare(Stream& s, int fd) {
     if (fd != checked_fd_) {
+      boost::system::error_code e;
+      s.native_non_blocking(true, e);
+      if (e) return false;  // Asio's own write then
       checked_fd_ = fd;
-      fd_socket_ = fd >= 0 && is_socket_fd(fd);
+      fd_socket_ = is_socket_fd(fd);
     }
-    return fd_socket_;
+    return true;
   }
 
   // --- deadlines: one wait on the timer watches many I/Os ---------------------------------------
@@ -195,7 +210,7 @@ class asio_driver {
   bool waiting_ = false;               // a wait is outstanding on timer_ ...
   clock::time_point wait_until_{};     // ... until then
   std::uint64_t generation_ = 0;       // that wait's number: completions of replaced waits are stale
-  int checked_fd_ = -1;                // the descriptor fd_socket_ describes
+  int checked_fd_ = -1;                // the descriptor prepared (non-blocking; fd_socket_ says what it is)
   bool fd_socket_ = false;
 };
 

@@ -236,24 +236,32 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
         running_ = p->id;
       }
       const auto ec = co_await asio_.run(stream_, machine_, p->req, worker_reopen_, direct_.bytes_waiting(stream_));
-      bool more = false;
       {
         std::lock_guard lock(m_);
         running_ = 0;
-        more = !queue_.empty();
       }
-      const bool blocked = p->blocked_caller;
-      // The completion runs on the strand only after this coroutine suspends or returns, so a
-      // blocked caller cannot see it before the line is released.
-      complete(std::move(*p), ec, machine_.reply());
-      // After an asynchronous completion, linger for one turn of the strand: the completion runs
-      // first, and a request its handler makes (a callback chain, a coroutine's next co_await)
-      // finds this worker still here instead of spawning a new one (whose frames would be
-      // allocated again). A blocked caller's next request comes from its own thread and should
-      // find the line idle, for the caller-thread driver: no lingering for it.
-      if (!more && !blocked)
-        co_await boost::asio::post(strand_, boost::asio::bind_allocator(asio_.alloc(), asio_type::use_task));
+      if (p->blocked_caller) {
+        // Through the strand: the blocked caller's next call must find the line idle, and the
+        // completion runs only after this coroutine has suspended or returned.
+        complete(std::move(*p), ec, machine_.reply());
+      } else {
+        // At once, on the handler's executor (inline when that is this thread's: a callback, a
+        // coroutine on this context): a request its handler makes is queued before this loop
+        // looks at the queue again, so the worker goes on with it, with no post in between.
+        complete_here(std::move(*p), ec, machine_.reply());
+      }
     }
+  }
+
+  /** Completes @p p now (dispatch to its executor), from the worker. */
+  void complete_here(pending p, error_code ec, const response& r) {
+    if (!ec && p.nack_is_error && r.kind == reply_kind::nack) ec = rcb4::errc::nack;
+    auto ex = boost::asio::get_associated_executor(p.handler, strand_);
+    boost::asio::dispatch(
+        ex, boost::asio::bind_allocator(asio_.alloc(), [h = std::move(p.handler), slot = p.slot, ec, r]() mutable {
+          if (slot.is_connected()) slot.clear();
+          std::move(h)(ec, r);
+        }));
   }
 
   /** Completes @p p with @p ec / @p r on its handler's executor, after the strand's current turn. */
@@ -347,7 +355,8 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
   clock::duration longest_exchange() const {
     const auto attempt =
         2 * (wire_time(128 + max_reply_size, opt_.baud) + opt_.turnaround) + 10 * (opt_.quiet + opt_.turnaround);
-    const clock::duration reconnect = reopen_ ? clock::duration(policy_.give_up_after + policy_.max_delay) : clock::duration{};
+    const clock::duration reconnect =
+        reopen_ ? clock::duration(policy_.give_up_after + policy_.max_delay) : clock::duration{};
     return (1 + opt_.read_retries) * attempt + reconnect + std::chrono::seconds(1);
   }
 
