@@ -57,10 +57,32 @@ class asio_driver {
     aborted_.reset();
     auto a = m.start(req, clock::now(), stray);
     for (;;) {
+      // (the I/O is awaited here, not in nested coroutines: each nesting costs a frame and two
+      // switches per exchange)
       io_result r;
       switch (a.what) {
-        case action::kind::write: r = co_await write_before(s, a); break;
-        case action::kind::read: r = co_await read_before(s, a); break;
+        case action::kind::write: {
+          arm(a.deadline);
+          auto st = write_now(s, a, r);
+          if constexpr (has_descriptor) {
+            while (st == write_state::wait) {  // no room yet
+              auto [e] = co_await s.async_wait(wait_write(), token());
+              st = e || timed_out_ ? write_state::done : write_now(s, a, r);
+              if (e || timed_out_) r = finish_io(0, e);
+            }
+          }
+          if (st == write_state::fallback) {
+            auto [e, n] = co_await s.async_write_some(boost::asio::buffer(a.out.data(), a.out.size()), token());
+            r = finish_io(n, e);
+          }
+          break;
+        }
+        case action::kind::read: {
+          arm(a.deadline);
+          auto [e, n] = co_await s.async_read_some(boost::asio::buffer(a.in.data(), a.in.size()), token());
+          r = finish_io(n, e);
+          break;
+        }
         case action::kind::reopen: r = co_await reopen_line(s, a.deadline, reopen); break;
         case action::kind::done: co_return a.ec;
       }
@@ -92,33 +114,33 @@ class asio_driver {
                                                boost::asio::as_tuple(boost::asio::bind_allocator(alloc(), use_task)));
   }
 
-  task<io_result> write_before(Stream& s, const action& a) {
-    arm(a.deadline);
+  enum class write_state { done, wait, fallback };
+  /**
+   * A frame is small and the line is idle: written at once with one system call, it needs no
+   * completion round trip through the scheduler (the bare Asio loop pays one per write). A
+   * socket, also one wrapped as a plain descriptor (which Asio would write() with SIGPIPE when
+   * the peer has gone), is written with send(MSG_NOSIGNAL). Streams without a descriptor fall
+   * back to Asio's write.
+   */
+  write_state write_now(Stream& s, const action& a, io_result& r) {
     if constexpr (has_descriptor) {
-      // A frame is small and the line is idle: written at once with one system call, it needs no
-      // completion round trip through the scheduler (the bare Asio loop pays one per write). A
-      // socket, also one wrapped as a plain descriptor (which Asio would write() with SIGPIPE
-      // when the peer has gone), is written with send(MSG_NOSIGNAL).
       const int fd = s.native_handle();
-      if (fd >= 0 && prepare(s, fd)) {
-        for (;;) {
-          const ssize_t n = write_nosignal(fd, fd_socket_, a.out);
-          if (n >= 0) co_return finish_io(static_cast<std::size_t>(n), {});
-          if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) co_return finish_io(0, os_error(errno));
-          if (errno == EINTR) continue;
-          auto [e] = co_await s.async_wait(wait_write(), token());  // no room yet
-          if (e || timed_out_) co_return finish_io(0, e);
+      if (fd < 0 || !prepare(s, fd)) return write_state::fallback;
+      for (;;) {
+        const ssize_t n = write_nosignal(fd, fd_socket_, a.out);
+        if (n >= 0) {
+          r = finish_io(static_cast<std::size_t>(n), {});
+          return write_state::done;
         }
+        if (errno == EINTR) continue;
+        if (errno == EAGAIN || errno == EWOULDBLOCK) return write_state::wait;
+        r = finish_io(0, os_error(errno));
+        return write_state::done;
       }
+    } else {
+      (void)s, (void)a, (void)r;
+      return write_state::fallback;
     }
-    auto [e, n] = co_await s.async_write_some(boost::asio::buffer(a.out.data(), a.out.size()), token());
-    co_return finish_io(n, e);
-  }
-
-  task<io_result> read_before(Stream& s, const action& a) {
-    arm(a.deadline);
-    auto [e, n] = co_await s.async_read_some(boost::asio::buffer(a.in.data(), a.in.size()), token());
-    co_return finish_io(n, e);
   }
 
   io_result finish_io(std::size_t n, error_code e) {

@@ -78,7 +78,7 @@ inline clock::duration wire_time(std::size_t bytes, std::uint32_t baud) noexcept
 /** The policy of one exchange at a time, and the state of the line between them. */
 class exchange_machine {
  public:
-  /** A machine using @p opt (read at each start, so changes apply to the next exchange). */
+  /** A machine using @p opt (read as it goes: change them only while no exchange runs). */
   exchange_machine(const client_options& opt, client_counters& counters) noexcept : opt_(&opt), n_(&counters) {}
 
   /** Whether a lost link can be reopened (a reopen function is set), and with which policy. */
@@ -109,9 +109,10 @@ class exchange_machine {
       case phase::write: return written(r, now);
       case phase::sync_read: return sync_read(r, now);
       case phase::read: return read(r, now);
+      case phase::echo_check: return echo_check(r, now);
       case phase::idle: break;
     }
-    return finish(transport_errc::cancelled);  // nothing was running
+    return done(transport_errc::cancelled);  // nothing was running
   }
 
   /**
@@ -138,7 +139,7 @@ class exchange_machine {
   clock::time_point deadline() const noexcept { return deadline_; }
 
  private:
-  enum class phase : std::uint8_t { idle, reopen, sync_write, sync_read, write, read };
+  enum class phase : std::uint8_t { idle, reopen, sync_write, sync_read, write, read, echo_check };
   static constexpr std::array<std::uint8_t, 4> ping_ack{0x04, 0xFE, 0x06, 0x08};  // protocol.md §4.11
   static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
 
@@ -256,7 +257,9 @@ class exchange_machine {
       }
       return timed_out(now);
     }
-    if (at_ack) {  // our ACK, unless more bytes follow it within `quiet`
+    if (at_ack && n > 0) {  // our ACK, unless more bytes follow it within `quiet`
+      // (every restart of the quiet period counts: a line that keeps sending ACKs is not settling)
+      if (sync_.synced && ++sync_.resettled > max_resettles) return timed_out(now);
       sync_.synced = true;
       deadline_ = now + opt_->quiet;
     } else if (n > 0 && sync_.synced) {  // more came after an ACK-like tail: read on to the real one
@@ -284,19 +287,46 @@ class exchange_machine {
   /** A complete frame arrived: the reply, or a malformed frame (resync, and retry if allowed). */
   action judge(clock::time_point now) {
     const auto& p = ex_->result();
+    const auto got = ex_->received_bytes();
     if (p.status == parse_status::error) {
-      error_code ec = p.error;
-      const auto got = ex_->received_bytes();
       const auto sent = req_->frame.bytes();
-      if (got.size() >= 2 && got.size() <= sent.size() && std::equal(got.begin(), got.end(), sent.begin())) {
-        dirty_ = true;  // our own bytes came back: a loopback, never a board (and no retry cures that)
-        return finish(transport_errc::echo);
+      if (!got.empty() && got.size() <= sent.size() && std::equal(got.begin(), got.end(), sent.begin())) {
+        // It starts like our own frame: read the rest of it to tell a loopback (which returns the
+        // whole frame, however its bytes are split) from a malformed reply.
+        phase_ = phase::echo_check;
+        echo_.matched = got.size();
+        echo_.error = p.error;
+        return echo_.matched == sent.size() ? finish_echo() : read_into(echo_buffer());
       }
-      return attempt_failed(ec, now);
+      return attempt_failed(p.error, now);
     }
+    if (p.consumed < got.size()) dirty_ = true;  // bytes after the reply (a NACK read where data was due)
     reply_ = response::from(p.value);
     if (reply_.kind == reply_kind::nack) ++n_->nacks;
     return finish({});
+  }
+
+  std::span<std::uint8_t> echo_buffer() { return std::span(junk_).first(req_->frame.size() - echo_.matched); }
+
+  action echo_check(const io_result& r, clock::time_point now) {
+    const auto sent = req_->frame.bytes();
+    const std::size_t n = std::min(r.n, sent.size() - echo_.matched);
+    n_->bytes_in += n;
+    trace(direction::rx, now, std::span(junk_).first(n));
+    if (!std::equal(junk_.begin(), junk_.begin() + static_cast<std::ptrdiff_t>(n),
+                    sent.begin() + static_cast<std::ptrdiff_t>(echo_.matched)))
+      return attempt_failed(echo_.error, now);  // not our frame after all: the malformed reply it was
+    echo_.matched += n;
+    if (echo_.matched == sent.size()) return finish_echo();
+    if (r.timed_out) return attempt_failed(echo_.error, now);
+    if (r.ec) return line_failed(r.ec, now);
+    return read_into(echo_buffer());
+  }
+
+  /** Our own bytes came back: a loopback, never a board (and no retry cures that). */
+  action finish_echo() {
+    dirty_ = true;
+    return finish(transport_errc::echo);
   }
 
   action timed_out(clock::time_point now) {
@@ -357,6 +387,10 @@ class exchange_machine {
   std::span<const std::uint8_t> out_{};
   std::optional<exchange> ex_;
   sync_state sync_{};
+  struct {
+    std::size_t matched = 0;  // bytes of our frame seen coming back
+    error_code error{};       // what the reply is if the rest does not match
+  } echo_{};
   std::array<std::uint8_t, 256> junk_{};
   clock::time_point give_up_{};
   clock::duration delay_{};
