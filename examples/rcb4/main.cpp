@@ -38,8 +38,7 @@ exit codes: 0 ok, 1 the board refused or answered wrongly, 2 usage, 3 device/I/O
 )";
 
 /** Exit code and hint for an error from the device. */
-int report(std::string_view cmd, const std::system_error& e) {
-  const std::error_code ec = e.code();
+int report(std::string_view cmd, const std::error_code& ec, std::string_view what) {
   namespace t = rcb4::transport;
   int code = cli::exit_io;
   std::string_view hint;
@@ -61,7 +60,7 @@ int report(std::string_view cmd, const std::system_error& e) {
   } else if (t::is_link_lost(ec)) {
     hint = "the device went away (unplugged?)";
   }
-  fmt::print(stderr, "rcb4 {}: {}\n", cmd, e.what());
+  fmt::print(stderr, "rcb4 {}: {}\n", cmd, what);
   if (!hint.empty()) fmt::print(stderr, "  {}\n", hint);
   return code;
 }
@@ -117,8 +116,11 @@ int main(int argc, char** argv) {
                a.command.empty() ? "" : fmt::format("{} ", a.command));
     return cli::exit_usage;
   } catch (const std::system_error& e) {
-    return report(a.command, e);
+    return report(a.command, e.code(), e.what());
   } catch (const boost::system::system_error& e) {
-    return report(a.command, std::system_error(std::error_code(e.code()), e.what()));
+    // Boost's what() ends with the code's location, " [category:value]": a person needs the words.
+    std::string_view what = e.what();
+    if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']') what = what.substr(0, at);
+    return report(a.command, std::error_code(e.code()), what);
   }
 }

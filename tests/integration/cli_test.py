@@ -23,9 +23,12 @@ def run(*args, stdin=None, timeout=60):
 
 class StandIn:
     """A minimal RCB-4 on a pty (protocol.md §2, §4): ping, VERSION, MOV RAM->COM, MOV literal->RAM,
-    SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing."""
+    SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing;
+    mode "nack" answers every frame with NACK, "badsum" spoils every reply's checksum, "echo"
+    sends every byte back (a loopback plug)."""
 
-    def __init__(self, silent=False):
+    def __init__(self, silent=False, mode=None):
+        self.mode = mode
         self.ram = bytearray(0x490)
         self.ram[0:2] = bytes([0x8B, 0x00])  # config word 0x008B
         for k in range(36):  # allocation table at 0x0044: ICS 0-2 allocated at 0x0090 + 20k
@@ -43,15 +46,22 @@ class StandIn:
         threading.Thread(target=self.serve, daemon=True).start()
 
     def reply(self, b):
-        os.write(self.master, bytes(b) + bytes([sum(b) & 0xFF]))
+        if self.mode == "nack":
+            b = [0x04, b[1], 0x15]
+        total = (sum(b) + (0x5A if self.mode == "badsum" else 0)) & 0xFF
+        os.write(self.master, bytes(b) + bytes([total]))
 
     def serve(self):
         buf = b""
         while True:
             try:
-                buf += os.read(self.master, 512)
+                got = os.read(self.master, 512)
             except OSError:
                 return
+            if self.mode == "echo":
+                os.write(self.master, got)
+                continue
+            buf += got
             while buf and len(buf) >= buf[0] >= 3:
                 f, buf = buf[:buf[0]], buf[buf[0]:]
                 self.frames.append(f)
@@ -217,5 +227,34 @@ check(rc == 4 and "no reply" in err and time.monotonic() - t0 < 5, f"silent boar
 rc, out, err = run("--device", silent.path, "--timeout", "20", "ping")
 check(rc == 4 and "no RCB-4 answered" in err, f"silent board, baud detection: exit 4 (rc {rc}: {err[:120]!r})")
 expect_rc(["--device", "/dev/does-not-exist", "--baud", "115200", "ping"], 3, "no such device")
+
+# ---- detection names the real cause, with its exit code, and --trace shows its frames --------
+expect_rc(["--device", "/dev/does-not-exist", "ping"], 3, "No such file")
+expect_rc(["--device", "/dev/null", "ping"], 3, "Inappropriate ioctl")
+for mode, rc_wanted, says in [("nack", 1, "NACK"), ("badsum", 1, "checksum"), ("echo", 1, "echoes")]:
+    bad = StandIn(mode=mode)
+    rc, out, err = run("--device", bad.path, "--timeout", "20", "ping")
+    check(rc == rc_wanted and says in err, f"detection against a {mode} board: exit {rc_wanted}, says {says!r} (rc {rc}: {err[:160]!r})")
+rc, out, err = run("--device", s.path, "--trace", "ping")
+check(rc == 0 and "-> 03 FE 01" in err and "<- 04 FE 06 08" in err, f"--trace shows the detection's frames ({err[:200]!r})")
+
+# ---- a pty that another program configured first (a C client's raw 8E1 at 115200) opens -----
+import termios
+for i in range(10):
+    fd = os.open(s.path, os.O_RDWR | os.O_NOCTTY)
+    attrs = termios.tcgetattr(fd)
+    tty.setraw(fd)
+    attrs = termios.tcgetattr(fd)
+    attrs[2] |= termios.PARENB | termios.CS8 | termios.CLOCAL | termios.CREAD
+    attrs[4] = attrs[5] = termios.B115200
+    try:
+        termios.tcsetattr(fd, termios.TCSANOW, attrs)  # a pty drops PARENB: glibc may say EINVAL
+    except termios.error:
+        pass
+    os.close(fd)
+    rc, out, err = run("--device", s.path, "ping")
+    if rc != 0:
+        break
+check(rc == 0 and "ACK" in out, f"a pty left raw 8E1 by another program answers, 10 times in a row (rc {rc}: {err[:160]!r})")
 
 finish()
