@@ -83,8 +83,11 @@ int main(int argc, char** argv) {
       };
       if (is_serve)
         rest.push_back(s);
-      else if (s == "--device")
+      else if (s == "--device") {
         g.device = std::string(value());
+        // An empty device is a mistake (an unset variable in a script), never the virtual board.
+        if (g.device.empty()) throw cli::usage_error{"--device is empty (leave it out for the virtual board)"};
+      }
       else if (s == "--baud")
         g.baud = static_cast<std::uint32_t>(cli::parse_int(value(), "--baud", 1200, 4000000));
       else if (s == "--timeout")

@@ -164,7 +164,7 @@ if os.geteuid() == 0:  # as a user without root, as most users run it
                        preexec_fn=nobody, cwd="/")
     check(p.returncode == 3 and "cpu_dma_latency" in p.stderr, "bench --low-latency without root: exit 3, says why")
 rc, out, err = run("--trace", "ping")
-check(rc == 0 and "-> 04 FE 06 08" in err and "<- 04 FE 06 08" in err and "ACK" in err, "--trace shows frames with meaning")
+check(rc == 0 and "-> 03 FE 01" in err and "<- 04 FE 06 08" in err and "ACK" in err, "--trace shows frames with meaning")
 
 # ---- offline: decode / encode (golden frames by hand from protocol.md) -----------------------
 expect_ok(["decode", "07 0F 00 0A 4C 1D 89"], "SINGLE ICS 0")
@@ -235,6 +235,9 @@ for mode, rc_wanted, says in [("nack", 1, "NACK"), ("badsum", 1, "checksum"), ("
     bad = StandIn(mode=mode)
     rc, out, err = run("--device", bad.path, "--timeout", "20", "ping")
     check(rc == rc_wanted and says in err, f"detection against a {mode} board: exit {rc_wanted}, says {says!r} (rc {rc}: {err[:160]!r})")
+    rc, out, err = run("--device", bad.path, "--baud", "115200", "--timeout", "20", "ping", "--count", "3")
+    check(rc == rc_wanted and says in err, f"--baud given, a {mode} board: exit {rc_wanted}, says {says!r} (rc {rc}: {err[:160]!r})")
+expect_rc(["--device", "", "ping"], 2, "--device is empty")
 rc, out, err = run("--device", s.path, "--trace", "ping")
 check(rc == 0 and "-> 03 FE 01" in err and "<- 04 FE 06 08" in err, f"--trace shows the detection's frames ({err[:200]!r})")
 

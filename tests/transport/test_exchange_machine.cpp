@@ -794,11 +794,11 @@ TEST_CASE("machine: bytes after an ACK-like tail keep the resync reading", "[tra
   CHECK(r.n.bytes_in == 4 + 1 + 4 + 4);
 }
 
-TEST_CASE("machine: a resync that never sees the ACK counts as a timed-out attempt", "[transport][machine]") {
+TEST_CASE("machine: a resync that never sees the ACK is a failed attempt", "[transport][machine]") {
   rig r;
   const auto p = ping_request();
   const auto s = single_request();
-  SECTION("ping: the next attempt resyncs again") {
+  SECTION("ping: bytes in no framing, the next attempt resyncs again") {
     auto a = r.start(p, 2);
     const auto deadline = a.deadline;
     a = r.resume(wrote_all(a));
@@ -809,7 +809,7 @@ TEST_CASE("machine: a resync that never sees the ACK counts as a timed-out attem
     REQUIRE(a.what == kind::write);
     CHECK(hex(a.out) == hex(short_ping));
     CHECK(ns(a.deadline - r.now) == ns(wire(7) + r.opt.turnaround));
-    CHECK(r.n.timeouts == 1);
+    CHECK(r.n.timeouts == 0);  // the line answered, in no framing the board uses: not a timeout
     CHECK(r.n.retries == 1);
     CHECK(r.n.resyncs == 2);
   }
@@ -972,7 +972,8 @@ TEST_CASE("machine: the request's own bytes coming back are a loopback, never re
 TEST_CASE("machine: a reply that only starts like our frame is the malformed reply it is", "[transport][machine]") {
   rig r;
   r.opt.read_retries = 0;
-  auto a = r.start(single_request());
+  const auto s = single_request();  // (the request outlives its exchange)
+  auto a = r.start(s);
   a = r.resume(wrote_all(a));
   a = r.resume(feed(a, bytes(0x07, 0x0F)));  // like our frame so far
   REQUIRE(a.what == kind::read);
@@ -1305,7 +1306,8 @@ TEST_CASE("machine: a byte read after a short NACK marks the line for a resync",
   // A read's first read asks for the whole data frame (5 bytes for 2 data bytes); a NACK is 4, so
   // a stray byte behind it lands in the same read: it must not be forgotten.
   rig r;
-  auto a = r.start(read_request());
+  const auto rd = read_request();  // (the request outlives its exchange)
+  auto a = r.start(rd);
   a = r.resume(wrote_all(a));
   REQUIRE(a.in.size() == 5);
   a = r.resume(feed(a, bytes(0x04, 0x00, 0x15, 0x19, 0x55)));  // NACK to MOV (§2.2), then 55
@@ -1313,6 +1315,36 @@ TEST_CASE("machine: a byte read after a short NACK marks the line for a resync",
   CHECK_FALSE(a.ec);
   CHECK(r.m.reply().kind == reply_kind::nack);
   CHECK(r.m.dirty());
-  a = r.start(read_request());
+  a = r.start(rd);
   CHECK(hex(a.out) == hex(bytes(0x03, 0xFE, 0x01)));  // the next exchange resyncs first
+}
+
+TEST_CASE("machine: a failed resync says what the line answered", "[transport][machine]") {
+  struct answer {
+    const char* name;
+    byte_vector bytes;
+    t::error_code ec;
+  };
+  const answer answers[] = {
+      {"silence", {}, t::transport_errc::timeout},
+      {"our ping coming back", bytes(0x03, 0xFE, 0x01), t::transport_errc::echo},
+      {"a NACK to the ping", bytes(0x04, 0xFE, 0x15, 0x17), rcb4::errc::nack},
+      {"an ACK with a bad checksum", bytes(0x04, 0xFE, 0x06, 0x5A), rcb4::errc::bad_checksum},
+      {"garbage", bytes(0x55, 0xAA, 0x13), rcb4::errc::bad_reply_length},
+  };
+  for (const auto& x : answers) {
+    DYNAMIC_SECTION(x.name) {
+      rig r;
+      r.opt.read_retries = 0;
+      const auto p = ping_request();
+      auto a = r.start(p, 1);  // stray bytes: a resync first
+      REQUIRE(hex(a.out) == hex(short_ping));
+      a = r.resume(wrote_all(a));
+      if (!x.bytes.empty()) a = r.resume(feed(a, x.bytes));
+      REQUIRE(a.what == kind::read);
+      a = r.resume(timed_out(), a.deadline - r.now);
+      REQUIRE(a.what == kind::done);
+      CHECK(a.ec == x.ec);
+    }
+  }
 }

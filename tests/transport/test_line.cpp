@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 
 using namespace rcb4;
 using namespace std::chrono_literals;
@@ -218,4 +219,46 @@ TEST_CASE("a peer that has gone is an error, never SIGPIPE, on every stream type
     CHECK(t::is_link_lost(ec));
   }
   CHECK(sigpipes == 0);
+}
+
+TEST_CASE("a TCP peer that has gone: every later exchange says so at once, never a timeout", "[transport][line]") {
+  t::io_thread io;
+  boost::asio::ip::tcp::acceptor acceptor(io.context(), {boost::asio::ip::make_address("127.0.0.1"), 0});
+  auto socket = t::connect(io.context(), "127.0.0.1:" + std::to_string(acceptor.local_endpoint().port()));
+  acceptor.accept().close();
+  std::this_thread::sleep_for(20ms);
+  t::client_options opt;
+  opt.turnaround = 200ms;
+  auto c = t::make_client(std::move(socket), opt);
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < 6; ++i) {
+    INFO("exchange " << i);
+    t::error_code ec;
+    if (i % 2 == 0) {
+      std::promise<t::error_code> done;
+      c.async_execute(ping{}, [&done](t::error_code e, t::response) { done.set_value(e); });
+      ec = done.get_future().get();
+    } else {
+      c.execute(ping{}, ec);
+    }
+    CHECK(ec);
+    CHECK(t::is_link_lost(ec));  // (an edge-triggered write waiting for a hang-up seen before gave timeouts)
+  }
+  CHECK(c.counters().timeouts == 0);
+  CHECK(std::chrono::steady_clock::now() - start < 1s);
+}
+
+TEST_CASE("a client on a pty's master side (a test harness's setup) still has its deadlines", "[transport][line]") {
+  // The master's termios belongs to the slave: a VTIME bound set on it would not limit a read.
+  t::pty_pair pty;  // nobody answers on the slave side
+  t::io_thread io;
+  t::client_options opt;
+  opt.turnaround = 300ms;  // whole tenths: a terminal's read would be bounded by VTIME
+  opt.read_retries = 0;
+  auto c = t::make_client(boost::asio::posix::stream_descriptor(io.context(), pty.release_master()), opt);
+  const auto start = std::chrono::steady_clock::now();
+  t::error_code ec;
+  c.execute(ping{}, ec);
+  CHECK(ec == t::transport_errc::timeout);
+  CHECK(std::chrono::steady_clock::now() - start < 2s);
 }

@@ -34,7 +34,7 @@ inline std::uint32_t detect_baud(boost::asio::io_context& io, const std::string&
   const auto rank = [](const error_code& e) {
     if (e == transport_errc::echo) return 4;
     if (e == rcb4::errc::nack) return 3;
-    if (e.category() == rcb4::codec_category()) return 2;
+    if (std::error_code(e).category() == rcb4::codec_category()) return 2;  // (Boost wraps std categories)
     return e == transport_errc::timeout ? 0 : 1;
   };
   for (const std::uint32_t baud : board_bauds) {

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <rcb4/transport/error.hpp>
+
 #include <boost/asio/connect.hpp>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -18,11 +20,16 @@ namespace rcb4::transport {
  */
 using tcp_socket = boost::asio::basic_stream_socket<boost::asio::ip::tcp, boost::asio::io_context::executor_type>;
 
-/** Connects to "HOST:PORT" (names resolved; IPv6 as "[::1]:3333"), with TCP_NODELAY set. */
-inline tcp_socket connect(boost::asio::io_context& io, const std::string& where, std::error_code& ec) {
+/**
+ * Connects to "HOST:PORT" (names resolved; IPv6 as "[::1]:3333"), with TCP_NODELAY set. A
+ * missing or non-numeric port, or one above 65535, is std::errc::invalid_argument.
+ */
+inline tcp_socket connect(boost::asio::io_context& io, const std::string& where, error_code& ec) {
   tcp_socket socket(io);
   const auto colon = where.rfind(':');
-  if (colon == std::string::npos || colon + 1 == where.size()) {
+  const auto port = colon == std::string::npos ? std::string() : where.substr(colon + 1);
+  const bool numeric = !port.empty() && port.size() <= 5 && port.find_first_not_of("0123456789") == std::string::npos;
+  if (!numeric || std::stoul(port) > 65535) {
     ec = std::make_error_code(std::errc::invalid_argument);
     return socket;
   }
@@ -37,11 +44,11 @@ inline tcp_socket connect(boost::asio::io_context& io, const std::string& where,
   return socket;
 }
 
-/** connect() that throws std::system_error. */
+/** connect() that throws system_error. */
 inline tcp_socket connect(boost::asio::io_context& io, const std::string& where) {
-  std::error_code ec;
+  error_code ec;
   auto s = connect(io, where, ec);
-  if (ec) throw std::system_error(ec, "connect " + where);
+  if (ec) throw system_error(ec, "connect " + where);
   return s;
 }
 

@@ -160,16 +160,18 @@ class asio_driver {
     co_return io_result{0, ec};
   }
 
-  static constexpr bool has_descriptor = posix_driver<Stream>::has_descriptor && requires(Stream & s) {
-    s.async_wait(boost::asio::posix::descriptor_base::wait_write, boost::asio::detached);
-    s.native_non_blocking(true);
-  };
   static constexpr auto wait_write() {
     if constexpr (posix_driver<Stream>::is_socket)
       return boost::asio::socket_base::wait_write;
     else
       return boost::asio::posix::descriptor_base::wait_write;
   }
+  // Sockets too: after a peer has gone, an Asio write queued behind the hang-up's edge (epoll is
+  // edge triggered) would wait for an edge that never comes; a direct send says EPIPE every time.
+  static constexpr bool has_descriptor = posix_driver<Stream>::has_descriptor && requires(Stream & s) {
+    s.async_wait(wait_write(), boost::asio::detached);
+    s.native_non_blocking(true);
+  };
   /** Once per descriptor: non-blocking (so a direct write never blocks), and whether it is a socket. */
   bool prepare(Stream& s, int fd) {
     if (fd != checked_fd_) {

@@ -163,12 +163,21 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     }
     lock.unlock();
     boost::asio::dispatch(strand_, boost::asio::bind_allocator(asio_.alloc(), [self = this->shared_from_this()] {
+                            {
+                              std::lock_guard l(self->m_);
+                              self->abort_ran_ = true;
+                              self->idle_.notify_all();
+                            }
                             self->asio_.abort(transport_errc::cancelled);
                             self->asio_.stop();
                             self->direct_.let_go(self->stream_);  // ends any I/O at once
                           }));
     if (running_here() || executor_stopped()) return;
+    // Someone runs the executor if the abort starts soon (a post on an idle context runs within
+    // microseconds); then the worker leaves at once. If it does not start, nobody is running the
+    // executor (a program between io.poll() calls): waiting longer would only freeze the caller.
     lock.lock();
+    if (!idle_.wait_for(lock, std::chrono::milliseconds(100), [this] { return abort_ran_ || !busy_; })) return;
     idle_.wait_for(lock, opt_.turnaround + std::chrono::seconds(1), [this] { return !busy_; });
   }
 
@@ -332,21 +341,25 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
       return {};
     }
     std::unique_lock lock(s->m);
-    const auto patience = (ahead + 1) * longest_exchange();
-    if (!s->cv.wait_for(lock, patience, [&s] { return s->done; })) {
+    // A worker that has not started within a turnaround and a second will not: nobody runs the
+    // executor. One that has started works through the queue within its deadlines.
+    clock::duration patience = opt_.turnaround + std::chrono::seconds(1);
+    for (int round = 0; !s->cv.wait_for(lock, patience, [&s] { return s->done; }); ++round) {
       lock.unlock();
       {
-        std::lock_guard q(m_);  // still queued: nobody ran the executor
-        if (queue_.take_if([id](const pending& p) { return p.id == id; })) {
+        std::lock_guard q(m_);
+        const bool stalled = !worker_started_ || round > 0;
+        if (stalled && queue_.take_if([id](const pending& p) { return p.id == id; })) {
+          ec = transport_errc::executor_not_running;  // still queued: nobody ran the executor
+          return {};
+        }
+        if (round > 0) {  // it ran, and has not ended within every request's deadlines
           ec = transport_errc::executor_not_running;
           return {};
         }
       }
-      lock.lock();  // it runs: its own deadlines end it, if the executor keeps running
-      if (!s->cv.wait_for(lock, longest_exchange(), [&s] { return s->done; })) {
-        ec = transport_errc::executor_not_running;
-        return {};
-      }
+      patience = static_cast<clock::rep>(ahead + 1) * longest_exchange();
+      lock.lock();
     }
     ec = s->ec;
     return s->r;
@@ -395,6 +408,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
   bool busy_ = false;            // an owner has the line (the worker or a calling thread)
   bool worker_started_ = false;  // the worker has run (it holds the line on the strand)
   bool closing_ = false;
+  bool abort_ran_ = false;  // shut_down's abort has started on the strand
   std::uint64_t next_id_ = 0;
   std::uint64_t running_ = 0;  // the worker's request
 };

@@ -88,11 +88,11 @@ class exchange_machine {
   }
 
   /**
-   * Begins @p r (which must outlive the exchange) at @p now. @p stray: bytes found waiting on
+   * Begins @p r (copied: a temporary is fine) at @p now. @p stray: bytes found waiting on
    * the line before anything was sent (a late or duplicated reply): a resync comes first.
    */
   action start(const request& r, clock::time_point now, std::size_t stray = 0) {
-    req_ = &r;
+    req_ = r;
     attempt_ = 0;
     attempts_ = 1 + ((r.idempotent || opt_->retry_writes) ? opt_->read_retries : 0);
     reply_ = response{};
@@ -144,7 +144,7 @@ class exchange_machine {
   static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
 
   clock::duration budget(std::size_t bytes) const { return wire_time(bytes, opt_->baud) + opt_->turnaround; }
-  std::size_t request_bytes() const { return req_->frame.size() + req_->shape.frame_size(); }
+  std::size_t request_bytes() const { return req_.frame.size() + req_.shape.frame_size(); }
 
   void trace(direction d, clock::time_point t, std::span<const std::uint8_t> b) const {
     if (opt_->trace && !b.empty()) opt_->trace(d, t, b);
@@ -204,10 +204,10 @@ class exchange_machine {
 
   action begin_exchange(clock::time_point now) {
     phase_ = phase::write;
-    ex_.emplace(req_->frame.bytes(), req_->shape);
+    ex_.emplace(req_.frame.bytes(), req_.shape);
     deadline_ = now + budget(request_bytes());
     expected_ = now + wire_time(request_bytes(), opt_->baud);
-    out_ = req_->frame.bytes();
+    out_ = req_.frame.bytes();
     trace(direction::tx, now, out_);
     return write(out_);
   }
@@ -255,7 +255,7 @@ class exchange_machine {
         dirty_ = false;
         return begin_exchange(now);
       }
-      return timed_out(now);
+      return sync_failed(now);
     }
     if (at_ack && n > 0) {  // our ACK, unless more bytes follow it within `quiet`
       // (every restart of the quiet period counts: a line that keeps sending ACKs is not settling)
@@ -268,6 +268,23 @@ class exchange_machine {
       deadline_ = now + budget(2 * ping_ack.size());
     }
     return read_into(junk_);
+  }
+
+  /**
+   * The resync saw no ACK before its deadline. Silence is a timeout; anything else says what the
+   * line is: our ping coming back (a loopback), a NACK, an ACK with a bad checksum (wrong rate or
+   * parity), or bytes in no framing the board uses.
+   */
+  action sync_failed(clock::time_point now) {
+    static constexpr std::array<std::uint8_t, 3> ping_short{0x03, 0xFE, 0x01};
+    static constexpr std::array<std::uint8_t, 4> ping_nack{0x04, 0xFE, 0x15, 0x17};  // protocol.md §2.2
+    const auto& t = sync_.tail;
+    if (sync_.seen == 0 || (sync_.seen >= 4 && t == ping_ack)) return timed_out(now);  // silence, or a late ACK
+    if (sync_.seen >= 3 && std::equal(ping_short.begin(), ping_short.end(), t.begin() + 1)) return finish_echo();
+    if (sync_.seen >= 4 && t == ping_nack) return attempt_failed(rcb4::errc::nack, now);
+    if (sync_.seen >= 4 && t[0] == 0x04 && t[1] == 0xFE && (t[2] == 0x06 || t[2] == 0x15))
+      return attempt_failed(rcb4::errc::bad_checksum, now);
+    return attempt_failed(rcb4::errc::bad_reply_length, now);
   }
 
   action read(const io_result& r, clock::time_point now) {
@@ -289,7 +306,7 @@ class exchange_machine {
     const auto& p = ex_->result();
     const auto got = ex_->received_bytes();
     if (p.status == parse_status::error) {
-      const auto sent = req_->frame.bytes();
+      const auto sent = req_.frame.bytes();
       if (!got.empty() && got.size() <= sent.size() && std::equal(got.begin(), got.end(), sent.begin())) {
         // It starts like our own frame: read the rest of it to tell a loopback (which returns the
         // whole frame, however its bytes are split) from a malformed reply.
@@ -306,10 +323,10 @@ class exchange_machine {
     return finish({});
   }
 
-  std::span<std::uint8_t> echo_buffer() { return std::span(junk_).first(req_->frame.size() - echo_.matched); }
+  std::span<std::uint8_t> echo_buffer() { return std::span(junk_).first(req_.frame.size() - echo_.matched); }
 
   action echo_check(const io_result& r, clock::time_point now) {
-    const auto sent = req_->frame.bytes();
+    const auto sent = req_.frame.bytes();
     const std::size_t n = std::min(r.n, sent.size() - echo_.matched);
     n_->bytes_in += n;
     trace(direction::rx, now, std::span(junk_).first(n));
@@ -380,7 +397,7 @@ class exchange_machine {
   bool lost_ = false;
   // the running exchange
   phase phase_ = phase::idle;
-  const request* req_ = nullptr;
+  request req_{};
   unsigned attempt_ = 0, attempts_ = 1;
   error_code telling_{};  // the most telling failure of the attempts so far
   clock::time_point deadline_{}, expected_{};

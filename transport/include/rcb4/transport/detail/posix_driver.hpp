@@ -47,6 +47,15 @@ inline ssize_t write_nosignal(int fd, bool socket, std::span<const std::uint8_t>
   return socket ? ::send(fd, b.data(), b.size(), MSG_NOSIGNAL) : ::write(fd, b.data(), b.size());
 }
 
+/**
+ * True when @p fd is a terminal whose reads a VTIME bound limits: not a pseudo-terminal's master
+ * side, whose termios settings belong to the slave (a read there would block without limit).
+ */
+inline bool is_bounded_tty(int fd) noexcept {
+  unsigned pty_number = 0;
+  return ::isatty(fd) == 1 && ::ioctl(fd, TIOCGPTN, &pty_number) != 0;
+}
+
 /** Runs exchanges on the calling thread over the descriptor of a @p Stream. */
 template <class Stream>
 class posix_driver {
@@ -68,14 +77,17 @@ class posix_driver {
   error_code run(Stream& s, exchange_machine& m, const client_options& opt, const request& req,
                  const reopen_function& reopen) {
     park(s);
-    auto a = m.start(req, clock::now(), bytes_waiting(s));
+    const auto stray = bytes_waiting(s);
+    auto a = m.start(req, clock::now(), stray);
     for (;;) {
+      io_result r;  // (performed first, then the time read: argument order is unspecified)
       switch (a.what) {
-        case action::kind::write: a = m.resume(write_before(s, a), clock::now()); break;
-        case action::kind::read: a = m.resume(read_before(s, a, opt), clock::now()); break;
-        case action::kind::reopen: a = m.resume(reopen_line(s, a.deadline, reopen), clock::now()); break;
+        case action::kind::write: r = write_before(s, a); break;
+        case action::kind::read: r = read_before(s, a, opt); break;
+        case action::kind::reopen: r = reopen_line(s, a.deadline, reopen); break;
         case action::kind::done: return a.ec;
       }
+      a = m.resume(r, clock::now());
     }
   }
 
@@ -142,6 +154,12 @@ class posix_driver {
     if constexpr (has_descriptor) {
       const int fd = line_fd(s);
       if (fd >= 0 && ::isatty(fd) == 1) ::ioctl(fd, TIOCNXCL);
+      termios t{};  // reads as open_serial left them (VMIN 1), not as the bounded reads set them
+      if (fd >= 0 && fd_.fd == fd && fd_.vtime != 0 && ::tcgetattr(fd, &t) == 0) {
+        t.c_cc[VMIN] = 1;
+        t.c_cc[VTIME] = 0;
+        ::tcsetattr(fd, TCSANOW, &t);  // (best effort: the descriptor is going)
+      }
     }
     if constexpr (can_park) {
       if (parked_ >= 0) ::close(parked_);
@@ -170,7 +188,7 @@ class posix_driver {
       if (parked_ >= 0) fd = parked_;
     if (fd < 0) fd = s.native_handle();
     if (fd >= 0 && fd != fd_.fd) {
-      fd_ = descriptor{fd, ::fcntl(fd, F_GETFL), !is_socket && ::isatty(fd) == 1, is_socket || is_socket_fd(fd)};
+      fd_ = descriptor{fd, ::fcntl(fd, F_GETFL), !is_socket && is_bounded_tty(fd), is_socket || is_socket_fd(fd)};
       if (fd_.flags >= 0 && (fd_.flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, fd_.flags | O_NONBLOCK);
       fd_.flags |= O_NONBLOCK;
     }
