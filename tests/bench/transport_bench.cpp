@@ -73,15 +73,24 @@ struct workload {
   std::vector<command> cmds;
 };
 
+/** @p w's frames and the sizes of their replies, for the bare loops. */
+struct wire_script {
+  std::vector<request_frame> frames;
+  std::vector<std::size_t> sizes;
+  explicit wire_script(const workload& w) {
+    for (const auto& c : w.cmds) {
+      frames.push_back(encode(c));
+      sizes.push_back(expected_reply(c).frame_size());
+    }
+  }
+};
+
 /** A raw C loop on @p path: each frame written, exactly its reply read; µs per pass over @p w. */
 double raw_loop_us(const std::string& path, const workload& w, int n) {
   const int fd = rcb4::testing::open_raw(path);
-  std::vector<request_frame> frames;
-  std::vector<std::size_t> sizes;
-  for (const auto& c : w.cmds) {
-    frames.push_back(encode(c));
-    sizes.push_back(expected_reply(c).frame_size());
-  }
+  const wire_script script(w);
+  const auto& frames = script.frames;
+  const auto& sizes = script.sizes;
   std::array<std::uint8_t, max_reply_size> buf{};
   bool ok = true;
   const auto start = clock_type::now();
@@ -101,12 +110,9 @@ double asio_loop_us(const std::string& path, const workload& w, int n) {
   boost::asio::co_spawn(
       io,
       [&]() -> boost::asio::awaitable<void> {
-        std::vector<request_frame> frames;
-        std::vector<std::size_t> sizes;
-        for (const auto& c : w.cmds) {
-          frames.push_back(encode(c));
-          sizes.push_back(expected_reply(c).frame_size());
-        }
+        const wire_script script(w);
+        const auto& frames = script.frames;
+        const auto& sizes = script.sizes;
         std::array<std::uint8_t, max_reply_size> buf{};
         const auto start = clock_type::now();
         for (int i = 0; i < n; ++i)
