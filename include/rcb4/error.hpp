@@ -53,10 +53,11 @@ enum class errc : std::uint8_t {
   baud_change_not_allowed,  ///< a config write that changes the COM baud (use ops::switch_baud)
   unsupported_baud,         ///< a COM rate other than 115200, 625000 or 1250000 (protocol.md §9)
   index_out_of_range,       ///< counter, user parameter, timer or AD index past the board's count
+  motion_slot_empty,        ///< the motion's ROM slot holds no program (erased: 0xFF)
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::index_out_of_range;
+inline constexpr errc errc_last = errc::motion_slot_empty;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -98,6 +99,7 @@ constexpr const char* message(errc e) noexcept {
       return "config write would change the COM baud; use switch_baud so the host follows";
     case errc::unsupported_baud: return "COM baud must be 115200, 625000 or 1250000";
     case errc::index_out_of_range: return "counter, parameter or timer index out of range";
+    case errc::motion_slot_empty: return "the motion slot holds no program (erased ROM): nothing to play";
   }
   return "unknown rcb4 error";
 }

@@ -135,7 +135,7 @@ TEST_CASE("ops: servo states through the allocation table", "[ops][servo]") {
 TEST_CASE("ops: play a motion, follow its state, stop one", "[ops][motion]") {
   board_wire w;
   ops::play_motion play(2);
-  CHECK(run(w, play).size() == 5);
+  CHECK(run(w, play).size() == 6);  // config, the slot's first bytes, suspend, PC, CALL, resume
   REQUIRE(play.error() == errc{});
   ops::read_motion_state st;
   run(w, st);
@@ -161,6 +161,47 @@ TEST_CASE("ops: play a motion, follow its state, stop one", "[ops][motion]") {
   ops::play_motion nope(121);
   CHECK(run(w, nope).empty());
   CHECK(nope.error() == errc::motion_out_of_range);
+}
+
+TEST_CASE("ops: an allocation table of zeros (no project) has no servos, not made-up ones", "[ops][servo]") {
+  board_wire w;
+  REQUIRE(w.write_ram(0x0044, std::vector<std::uint8_t>(70, 0x00)).is_ack());  // every entry 0x0000
+  ops::scan_servos scan;
+  run(w, scan);
+  CHECK(scan.error() == errc{});
+  CHECK(scan.value().empty());
+  ops::read_servo_states states;
+  run(w, states);
+  CHECK(states.error() == errc{});
+  CHECK(states.value().empty());  // not 22 servos read from the config word and the program counter
+}
+
+TEST_CASE("ops: an empty motion slot is refused before anything changes", "[ops][motion]") {
+  board_wire w;
+  const auto before = w.read_word(0);
+  ops::play_motion play(120);  // the virtual board's slot 120 is erased ROM (0xFF)
+  const auto sent = run(w, play);
+  CHECK(play.error() == errc::motion_slot_empty);
+  CHECK(sent.size() == 2);  // the config and the slot read: no write
+  CHECK(w.read_word(0) == before);
+}
+
+TEST_CASE("ops: a refused CALL restores the config read at the start", "[ops][motion]") {
+  board_wire w;
+  const auto before = w.read_word(0);
+  REQUIRE(config_word::decode(before).rom_program);
+  ops::play_motion play(2);
+  std::vector<command> sent;
+  while (auto c = play.next()) {
+    sent.push_back(*c);
+    // The board refuses the CALL (a full stack on a real board; protocol.md §4.3): NACK 04 0C 15 25.
+    play.on_reply(std::holds_alternative<call>(*c) ? reply::nack(0x0C) : w.send(*c));
+  }
+  CHECK(play.error() == errc::nack);
+  CHECK(play.refused());
+  REQUIRE(sent.size() == 6);        // ... then the restoring write
+  CHECK(w.read_word(0) == before);  // the ROM program runs again, as it did
+  CHECK(play.value() == before);
 }
 
 TEST_CASE("ops: sensors, PIO, receiver and degrees", "[ops][sensors]") {

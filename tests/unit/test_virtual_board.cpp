@@ -258,6 +258,17 @@ TEST_CASE("board: a write of the COM baud bits switches the line after the reply
   CHECK(w.board().line_baud() == 625000);
 }
 
+TEST_CASE("board: writing 0 to the stack pointer counter resets the stack (play step 2)", "[board][flow]") {
+  board_wire w;
+  REQUIRE(w.write_ram(0x0000, {0x00, 0x00}).is_ack());  // suspended: nothing returns by itself
+  for (int play = 0; play < 40; ++play) {               // motions played in quick succession
+    INFO("play " << play);
+    REQUIRE(w.write_ram(0x0002, {0x4B, 0x04, 0x00, 0, 0, 0, 0, 0, 0, 0}).is_ack());  // PC, SP = 0, flags
+    REQUIRE(w.send(call{motion_address(hth4_2_2, 2).value()}).is_ack());
+    CHECK(w.read_ram(0x0005, 1)[0] == 1);  // one CALL deep, whatever came before
+  }
+}
+
 TEST_CASE("board: KONDO's four-step motion play moves the servos, status per §8.2", "[board][motion]") {
   board_wire w;
   auto status = [&w] {

@@ -462,6 +462,9 @@ class virtual_board {
   outcome run(const call& c, origin from) {
     const auto cfg = config();
     if (!c.cond().holds(cfg.zero_flag, cfg.carry_flag)) return {};
+    // The stack pointer counter in RAM is the stack's depth: KONDO's play sequence resets it by
+    // writing 0 (protocol.md §8.1 step 2), and the stack then starts over.
+    stack_size_ = std::min<std::size_t>(ram_[ram::stack_pointer.value()], stack_depth);
     if (stack_size_ >= stack_depth) return nack();
     // From ROM the PC already points past the CALL; from COM it is where the program stands.
     stack_[stack_size_++] = pc();
@@ -471,7 +474,8 @@ class virtual_board {
     return {};
   }
   outcome run(const ret&, origin) {
-    if (stack_size_ == 0 || ram_[ram::stack_pointer.value()] == 0) {
+    stack_size_ = std::min<std::size_t>(ram_[ram::stack_pointer.value()], stack_depth);  // (see CALL)
+    if (stack_size_ == 0) {
       stack_size_ = 0;
       set_rom_program(false);  // RETURN without CALL stops the program (DOC-CMD)
       return {};

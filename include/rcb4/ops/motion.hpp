@@ -25,7 +25,13 @@ inline std::array<std::uint8_t, 2> le(std::uint16_t v) noexcept {
 }
 }  // namespace detail
 
-/** Plays motion @p n (1-based) of @p layout. value(): the config word it resumed with. */
+/**
+ * Plays motion @p n (1-based) of @p layout. value(): the config word it wrote last. Before
+ * anything changes, the slot's first bytes are read: an erased slot (0xFF, no frame) is
+ * errc::motion_slot_empty and nothing is sent. A CALL the board refuses (a full stack, a bad
+ * address) does not leave the program stopped: the config word read at the start is written
+ * back (the main loop runs again), then error() is errc::nack.
+ */
 class play_motion {
  public:
   /** Motion @p n of @p layout; an impossible number shows in error() at once. */
@@ -45,17 +51,24 @@ class play_motion {
     if (error_ != errc{}) return std::nullopt;
     switch (step_) {
       case 0: return command{move::read_ram(ram::config, 2).value()};
-      case 1: return command{move::write_ram(ram::config, suspend_).value()};
-      case 2: return command{move::write_ram(ram::program_counter, reset_).value()};
-      case 3: return command{call{target_}};
-      case 4: return command{move::write_ram(ram::config, resume_).value()};
+      case 1: return command{move::read_rom(target_, 2).value()};  // (2 bytes: a 1-byte read looks like a NACK)
+      case 2: return command{move::write_ram(ram::config, suspend_).value()};
+      case 3: return command{move::write_ram(ram::program_counter, reset_).value()};
+      case 4: return command{call{target_}};
+      case 5: return command{move::write_ram(ram::config, refused_ ? original_ : resume_).value()};
       default: return std::nullopt;
     }
   }
   /** Takes a reply. */
   void on_reply(const reply& r) {
-    if ((error_ = detail::check_reply(r, step_ == 0, 2)) != errc{}) return;
+    if (step_ == 4 && r.is_nack()) {  // refused: restore the program's config, then report it
+      refused_ = true;
+      ++step_;
+      return;
+    }
+    if ((error_ = detail::check_reply(r, step_ <= 1, 2)) != errc{}) return;
     if (step_ == 0) {
+      original_ = detail::le(r.u16());
       auto c = config_word::decode(r.u16());
       c.rom_program = c.vector_jump = c.interpolation_message = false;
       if (power_ == servo_power::release) c.ics_enabled = false;
@@ -63,6 +76,12 @@ class play_motion {
       c.rom_program = c.vector_jump = c.ics_enabled = true;
       resumed_ = c.encode();
       resume_ = detail::le(resumed_);
+    } else if (step_ == 1) {
+      const std::uint8_t size = r.bytes()[0];  // a program starts with a frame: SIZE 3..128 (§2.1)
+      if (size < 3 || size > max_request_size) error_ = errc::motion_slot_empty;
+    } else if (step_ == 5 && refused_) {
+      resumed_ = static_cast<std::uint16_t>(original_[0] | (original_[1] << 8));
+      error_ = errc::nack;
     }
     ++step_;
   }
@@ -70,15 +89,18 @@ class play_motion {
   errc error() const noexcept { return error_; }
   /** The config word written at the end. */
   std::uint16_t value() const noexcept { return resumed_; }
+  /** True when the board refused the CALL (then the config read at the start was restored). */
+  bool refused() const noexcept { return refused_; }
 
  private:
   rom_layout layout_;
   servo_power power_;
   rom_address target_{};
-  std::array<std::uint8_t, 2> suspend_{}, resume_{};
+  std::array<std::uint8_t, 2> suspend_{}, resume_{}, original_{};
   std::array<std::uint8_t, 10> reset_{};
   std::uint16_t resumed_ = 0;
   unsigned step_ = 0;
+  bool refused_ = false;
   errc error_{};
 };
 

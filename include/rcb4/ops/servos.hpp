@@ -42,12 +42,18 @@ struct servo_slot {
 namespace detail {
 /** The allocation table read: ICS 0–34, 2 bytes each at 0x0044 (ICS 35 has no entry, §6). */
 inline command read_allocation() { return command{move::read_ram(ram::ics_allocation, 70).value()}; }
-/** The allocated slots in a reply to read_allocation() (entries pointing past RAM are skipped). */
+/**
+ * The allocated slots in a reply to read_allocation(). An entry is a servo block only inside the
+ * user area (0x0090–0x048F, protocol.md §6): 0xFFFF (none), and entries pointing into the
+ * system registers (a table of zeros, as on a board without a project) or past RAM, are not
+ * servos, so nothing is ever read from the config word or the program counter as a position.
+ */
 inline std::vector<servo_slot> allocated_slots(const reply& r) {
   std::vector<servo_slot> slots;
   for (unsigned k = 0; k < 35; ++k) {
     const std::uint16_t a = r.u16(2 * k);
-    if (a == ram::no_allocation || std::uint32_t{a} + servo_block::size > ram_size) continue;
+    if (a == ram::no_allocation || a < ram::user_area.value() || std::uint32_t{a} + servo_block::size > ram_size)
+      continue;
     slots.push_back({ics_number::make(k).value(), a});
   }
   return slots;
