@@ -144,6 +144,8 @@ expect_ok(["motion", "status"], "no motion running")
 expect_ok(["motion", "stop"], "stopped")
 expect_ok(["motion", "resume"], "resumed")
 expect_rc(["motion", "play", "121"], 2, "outside 1..120")
+expect_rc(["motion", "play", "120"], 1, "holds no program")  # an erased slot: refused before anything changes
+expect_ok(["motion", "status"], "no motion running")
 expect_rc(["motion", "play", "1", "--layout", "9.9"], 2, "--layout")
 expect_ok(["bench", "--count", "20"], "control cycle")
 rc, out, err = run("bench", "--count", "20", "--low-latency")
