@@ -127,12 +127,20 @@ int ping_cmd(session& s, const parsed& p, const globals& g) {
   const auto [lo, hi] = std::minmax_element(us.begin(), us.end());
   double sum = 0;
   for (double v : us) sum += v;
+  // Late replies are retried and resynchronised by the client: say so, or "ACK" hides a bad line.
+  const auto& k = s.c().counters();
+  const auto retries = k.retries.load(), timeouts = k.timeouts.load(), resyncs = k.resyncs.load();
   if (g.json)
-    fmt::print("{{\"count\":{},\"min_us\":{:.1f},\"avg_us\":{:.1f},\"max_us\":{:.1f},\"baud\":{}}}\n", n, *lo,
-               sum / static_cast<double>(n), *hi, s.baud());
+    fmt::print(
+        "{{\"count\":{},\"min_us\":{:.1f},\"avg_us\":{:.1f},\"max_us\":{:.1f},\"baud\":{},\"retries\":{},"
+        "\"timeouts\":{},\"resyncs\":{}}}\n",
+        n, *lo, sum / static_cast<double>(n), *hi, s.baud(), retries, timeouts, resyncs);
   else if (n > 1)
     fmt::print("{} pings: min {:.0f} us, avg {:.0f} us, max {:.0f} us ({} baud)\n", n, *lo,
                sum / static_cast<double>(n), *hi, s.baud());
+  if (!g.json && (retries > 0 || timeouts > 0))
+    fmt::print("{} retries after {} timeouts ({} resyncs): replies come late or get lost\n", retries, timeouts,
+               resyncs);
   return exit_ok;
 }
 

@@ -25,7 +25,7 @@ class StandIn:
     """A minimal RCB-4 on a pty (protocol.md §2, §4): ping, VERSION, MOV RAM->COM, MOV literal->RAM,
     SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing;
     mode "nack" answers every frame with NACK, "badsum" spoils every reply's checksum, "echo"
-    sends every byte back (a loopback plug)."""
+    sends every byte back (a loopback plug), "drop" leaves every third frame unanswered."""
 
     def __init__(self, silent=False, mode=None):
         self.mode = mode
@@ -66,6 +66,8 @@ class StandIn:
                 f, buf = buf[:buf[0]], buf[buf[0]:]
                 self.frames.append(f)
                 if self.silent or sum(f[:-1]) & 0xFF != f[-1]:
+                    continue
+                if self.mode == "drop" and len(self.frames) % 3 == 0:
                     continue
                 cmd = f[1]
                 if cmd == 0xFE:
@@ -240,6 +242,11 @@ for mode, rc_wanted, says in [("nack", 1, "NACK"), ("badsum", 1, "checksum"), ("
     rc, out, err = run("--device", bad.path, "--baud", "115200", "--timeout", "20", "ping", "--count", "3")
     check(rc == rc_wanted and says in err, f"--baud given, a {mode} board: exit {rc_wanted}, says {says!r} (rc {rc}: {err[:160]!r})")
 expect_rc(["--device", "", "ping"], 2, "--device is empty")
+lossy = StandIn(mode="drop")
+rc, out, err = run("--device", lossy.path, "--baud", "115200", "--timeout", "30", "ping", "--count", "4")
+check(rc == 0 and "retries after" in out, f"ping --count on a lossy line says it retried ({out[-160:]!r})")
+rc, out, err = run("--json", "--device", lossy.path, "--baud", "115200", "--timeout", "30", "ping", "--count", "4")
+check(rc == 0 and json.loads(out)["retries"] > 0 and json.loads(out)["timeouts"] > 0, f"ping --json counts retries ({out!r})")
 rc, out, err = run("--device", s.path, "--trace", "ping")
 check(rc == 0 and "-> 03 FE 01" in err and "<- 04 FE 06 08" in err, f"--trace shows the detection's frames ({err[:200]!r})")
 
