@@ -6,7 +6,9 @@
 //    targets: blocking >= 0.90x the raw loop, async >= 0.85x; heap allocations per exchange in
 //    steady state (target 0), the client's only;
 //  - a control cycle (read every servo's state + write 36 servos) against the board paced at
-//    1.25 Mbaud, next to the wire limit of those bytes and to the same cycle by a raw loop.
+//    1.25 Mbaud, next to the wire limit of those bytes and to the same cycle by a raw loop;
+//  - with `--device PATH [--baud B]`, instead: the same workloads by the blocking API next to a raw
+//    C loop on a board that is not this project's (tests/integration/standin.py, or a real one).
 // The machine's speed drifts (a 2-core virtual machine: tens of µs per wake-up, changing from
 // second to second), so the floors and the client take turns in short rounds, in a rotating
 // order; each ratio printed is the median of the rounds' own ratios (each compares neighbours
@@ -252,9 +254,47 @@ void pass(const std::vector<workload>& loads, const command& write36) {
   }
   control_cycle(write36);
 }
+/**
+ * Against a board that is not part of this project (a stand-in in another language on a pty,
+ * or a real board): the blocking API next to a raw C loop on the same device, in turns. The
+ * client is opened for each of its rounds and closed after, so the raw loop never shares the line.
+ */
+int external(const std::string& path, std::uint32_t baud, const std::vector<workload>& loads) {
+  std::printf(
+      "rcb4 transport bench against %s at %u baud: the blocking API next to a raw C loop on the same\n"
+      "device, in turns (15 rounds); operations per second, ratios are medians of per-round ratios\n\n",
+      path.c_str(), baud);
+  std::printf("  %-22s %9s   %16s\n", "per second", "raw C loop", "blocking API");
+  t::io_thread io;
+  for (const auto& w : loads) {
+    const int per_round = std::max<int>(20, 400 / static_cast<int>(w.cmds.size() * w.cmds.size())), rounds = 15;
+    const auto blocking = [&] {
+      t::client_options opt;
+      opt.baud = baud;
+      auto c = t::make_client(t::open_serial(io.context(), path, baud), opt);
+      for (const auto& cmd : w.cmds) c.execute(cmd);  // warm up
+      const auto start = clock_type::now();
+      for (int i = 0; i < per_round; ++i)
+        for (const auto& cmd : w.cmds) c.execute(cmd);
+      return us_since(start, per_round);
+    };
+    const auto us = take_turns({[&] { return raw_loop_us(path, w, per_round); }, blocking}, rounds);
+    std::printf("  %-22s %7.0f/s   %7.0f/s %5.2fx (target 0.90x)\n", w.name, 1e6 / median(us[0]), 1e6 / median(us[1]),
+                ratio(us[0], us[1]));
+  }
+  return 0;
+}
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
+  std::string device;
+  std::uint32_t device_baud = 115200;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string_view a = argv[i];
+    if (a == "--device") device = argv[i + 1];
+    if (a == "--baud") device_baud = static_cast<std::uint32_t>(std::stoul(argv[i + 1]));
+  }
+
   servo_set<servo_position> all36;
   for (int i = 0; i < 36; ++i) all36.insert(ics_number::make(i).value(), 7600);
   const command write36 = const_servo::make(all36, 10).value();
@@ -264,6 +304,7 @@ int main() {
   control.cmds.push_back(write36);
   const std::vector<workload> loads = {
       {"ping", {ping{}}}, {"MOV read 2 bytes", {move::read_ram(0x0090, 2).value()}}, {"CONST36", {write36}}, control};
+  if (!device.empty()) return external(device, device_baud, loads);
   std::printf("rcb4 transport benchmarks: pty, virtual board (unpaced unless said); operations per second\n");
   std::printf("(a control loop's operation is its 6 exchanges); ratios are medians of per-round ratios\n\n");
   std::printf("CPU idle states as configured (wake-up latency bound %lld us):\n",
