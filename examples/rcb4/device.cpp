@@ -352,9 +352,20 @@ std::optional<rcb4::servo_mask> parse_servos(const parsed& p, std::size_t from) 
   if (p.positional.size() <= from || (p.positional.size() == from + 1 && p.positional[from] == "all"))
     return std::nullopt;
   rcb4::servo_mask m;
-  for (std::size_t i = from; i < p.positional.size(); ++i)
-    m.insert(checked<ics_number>(parse_int(p.positional[i], "ICS", 0, 35), "ICS"));
+  for (std::size_t i = from; i < p.positional.size(); ++i) {
+    const auto n = checked<ics_number>(parse_int(p.positional[i], "ICS", 0, 35), "ICS");
+    if (m.contains(n)) throw usage_error{fmt::format("ICS {} is given twice", n.value())};
+    m.insert(n);
+  }
   return m;
+}
+
+/** Refuses (usage, nothing sent) servos the board has no block for: the board would ignore them. */
+void require_allocated(session& s, const rcb4::servo_mask& m, std::string_view cmd) {
+  const auto slots = s.run(rcb4::ops::scan_servos{});
+  for (auto n : m)
+    if (std::none_of(slots.begin(), slots.end(), [&](const auto& slot) { return slot.ics == n; }))
+      throw usage_error{fmt::format("{}: ICS {} has no servo allocated (see rcb4 servo list)", cmd, n.value())};
 }
 
 int servo_cmd(session& s, const parsed& p, const globals& g) {
@@ -400,15 +411,18 @@ int servo_cmd(session& s, const parsed& p, const globals& g) {
       } else {
         pos = checked<rcb4::servo_position>(parse_int(rest, "POS", 0, 16383), "POS");
       }
+      if (targets.contains(ics)) throw usage_error{fmt::format("servo move: ICS {} is given twice", ics.value())};
       targets.insert(ics, {pos, checked<rcb4::frames>(frames, "FRAMES")});
     }
     if (targets.empty()) throw usage_error{"servo move: give ICS=POS pairs, e.g. 0=7500 1=8000@10"};
+    require_allocated(s, targets.mask(), "servo move");
     const auto moved = s.run(rcb4::ops::move_servos(targets));
     if (!g.json) fmt::print("moving {} servo{}\n", moved.size(), moved.size() == 1 ? "" : "s");
     return exit_ok;
   }
   if (sub == "free" || sub == "hold") {
     const auto which = parse_servos(p, 1);
+    if (which) require_allocated(s, *which, fmt::format("servo {}", sub));
     const auto done = s.run(
         rcb4::ops::set_servo_power(sub == "free" ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, which));
     if (!g.json)
@@ -418,6 +432,7 @@ int servo_cmd(session& s, const parsed& p, const globals& g) {
   if (sub == "speed" || sub == "stretch") {
     const auto v = checked<rcb4::servo_param>(parse_int(word(p, 1, "VALUE (1..127)"), "VALUE", 1, 127), "VALUE");
     const auto which = parse_servos(p, 2);
+    if (which) require_allocated(s, *which, fmt::format("servo {}", sub));
     const auto done = s.run(
         rcb4::ops::set_servo_param(sub == "speed" ? rcb4::param_kind::speed : rcb4::param_kind::stretch, v, which));
     if (!g.json) fmt::print("{} = {} on {} servo{}\n", sub, v.value(), done.size(), done.size() == 1 ? "" : "s");

@@ -87,10 +87,12 @@ int main(int argc, char** argv) {
         g.device = std::string(value());
         // An empty device is a mistake (an unset variable in a script), never the virtual board.
         if (g.device.empty()) throw cli::usage_error{"--device is empty (leave it out for the virtual board)"};
-      }
-      else if (s == "--baud")
-        g.baud = static_cast<std::uint32_t>(cli::parse_int(value(), "--baud", 1200, 4000000));
-      else if (s == "--timeout")
+      } else if (s == "--baud") {
+        const auto b = static_cast<std::uint32_t>(cli::parse_int(value(), "--baud", 1200, 4000000));
+        if (b != 115200 && b != 625000 && b != 1250000)  // the board's COM rates (protocol.md §9)
+          throw cli::usage_error{fmt::format("--baud {}: the RCB-4 speaks 115200, 625000 or 1250000", b)};
+        g.baud = b;
+      } else if (s == "--timeout")
         g.timeout = std::chrono::milliseconds(cli::parse_int(value(), "--timeout", 1, 600000));
       else if (s == "--trace")
         g.trace = true;
