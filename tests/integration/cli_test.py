@@ -182,6 +182,11 @@ for mode, rc_wanted, says in [("nack", 1, "NACK"), ("badsum", 1, "checksum"), ("
     rc, out, err = run("--device", bad.path, "--baud", "115200", "--timeout", "20", "ping", "--count", "3")
     check(rc == rc_wanted and says in err, f"--baud given, a {mode} board: exit {rc_wanted}, says {says!r} (rc {rc}: {err[:160]!r})")
 expect_rc(["--device", "", "ping"], 2, "--device is empty")
+if os.geteuid() == 0:  # a port the user may not open (the stand-in's pty belongs to root, mode 0620)
+    p = subprocess.run([RCB4, "--device", s.path, "ping"], capture_output=True, text=True, timeout=60,
+                       preexec_fn=nobody, cwd="/")
+    check(p.returncode == 3 and "Permission denied" in p.stderr and "dialout" in p.stderr,
+          f"detection without permission: exit 3, says so, with the fix ({p.returncode}: {p.stderr[:160]!r})")
 expect_rc(["--baud", "9600", "ping"], 2, "115200, 625000 or 1250000")
 lossy = StandIn(mode="drop")
 rc, out, err = run("--device", lossy.path, "--baud", "115200", "--timeout", "30", "ping", "--count", "4")
