@@ -142,6 +142,16 @@ struct rig {
     REQUIRE(ns(a.deadline - now) == ns(opt.quiet));
     return resume(timed_out(), opt.quiet);
   }
+  /** From @p a, the config read's frame goes out and its reply comes: done, no error, 0x008B. */
+  void read_answered(d::action a) {
+    REQUIRE(a.what == kind::write);
+    CHECK(hex(a.out) == hex(read_frame));
+    a = resume(wrote_all(a));
+    a = resume(feed(a, read_reply));
+    REQUIRE(a.what == kind::done);
+    CHECK_FALSE(a.ec);
+    CHECK(m.reply().u16() == 0x008B);
+  }
   /** Nothing ever answers: every write goes out, every read times out at its deadline. The writes. */
   std::vector<byte_vector> silent_line(d::action a) {
     std::vector<byte_vector> writes;
@@ -162,10 +172,10 @@ struct rig {
 }  // namespace
 
 TEST_CASE("machine: wire time is 11 bits a byte at the line rate", "[transport][machine]") {
-  CHECK(ns(d::wire_time(8, 1'250'000)) == 70'400);         // 88 bits at 1.25 Mbit/s
-  CHECK(ns(d::wire_time(9, 115'200)) == 859'375);          // 99 bits at 115200 bit/s
-  CHECK(ns(d::wire_time(1, 625'000)) == 17'600);           // 11 bits at 625 kbit/s
-  CHECK(ns(d::wire_time(15, test_baud)) == ns(wire(15)));  // the helper of these tests agrees
+  CHECK(ns(t::wire_time(8, 1'250'000)) == 70'400);         // 88 bits at 1.25 Mbit/s
+  CHECK(ns(t::wire_time(9, 115'200)) == 859'375);          // 99 bits at 115200 bit/s
+  CHECK(ns(t::wire_time(1, 625'000)) == 17'600);           // 11 bits at 625 kbit/s
+  CHECK(ns(t::wire_time(15, test_baud)) == ns(wire(15)));  // the helper of these tests agrees
 }
 
 TEST_CASE("machine: a clean exchange writes the frame, reads the reply, ends without error", "[transport][machine]") {
@@ -670,13 +680,7 @@ TEST_CASE("machine: a duplicated reply stays on the line and is discarded by a r
     REQUIRE(a.what == kind::read);
     CHECK(ns(a.deadline - r.now) == ns(r.opt.quiet));
     a = r.resume(timed_out(), r.opt.quiet);
-    REQUIRE(a.what == kind::write);
-    CHECK(hex(a.out) == hex(read_frame));
-    a = r.resume(wrote_all(a));
-    a = r.resume(feed(a, read_reply));
-    REQUIRE(a.what == kind::done);
-    CHECK_FALSE(a.ec);
-    CHECK(r.m.reply().u16() == 0x008B);
+    r.read_answered(a);
     CHECK(r.n.retries == 0);
     CHECK(r.n.errors == 0);
     CHECK(r.n.resyncs == 1);
@@ -693,13 +697,7 @@ TEST_CASE("machine: a duplicated reply stays on the line and is discarded by a r
     a = r.resume(feed(a, join(read_reply, ping_ack)));  // the first attempt's late reply, then the ACK
     REQUIRE(a.what == kind::read);
     a = r.resume(timed_out(), r.opt.quiet);
-    REQUIRE(a.what == kind::write);
-    CHECK(hex(a.out) == hex(read_frame));
-    a = r.resume(wrote_all(a));
-    a = r.resume(feed(a, read_reply));
-    REQUIRE(a.what == kind::done);
-    CHECK_FALSE(a.ec);
-    CHECK(r.m.reply().u16() == 0x008B);
+    r.read_answered(a);
     CHECK(r.n.retries == 1);
     CHECK(r.n.errors == 0);
   }
@@ -1057,13 +1055,7 @@ TEST_CASE("machine: a lost link is reopened at once, and the frame written witho
     REQUIRE(a.what == kind::reopen);
     CHECK(ns(a.deadline - r.now) == ns(20ms));
     a = r.resume(moved(0), a.deadline - r.now);  // back
-    REQUIRE(a.what == kind::write);
-    CHECK(hex(a.out) == hex(read_frame));
-    a = r.resume(wrote_all(a));
-    a = r.resume(feed(a, read_reply));
-    REQUIRE(a.what == kind::done);
-    CHECK_FALSE(a.ec);
-    CHECK(r.m.reply().u16() == 0x008B);
+    r.read_answered(a);
     CHECK(r.n.reconnects == 1);
     CHECK(r.n.resyncs == 0);
   }

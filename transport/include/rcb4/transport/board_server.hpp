@@ -11,6 +11,7 @@
 #pragma once
 
 #include <rcb4/board/virtual_board.hpp>
+#include <rcb4/transport/options.hpp>
 #include <rcb4/transport/pty.hpp>
 
 #include <boost/asio.hpp>
@@ -43,11 +44,6 @@ struct serve_options {
    */
   std::function<std::vector<reply_piece>(std::size_t reply_size)> pieces;
 };
-
-/** Wire time of @p bytes at @p baud with 8E1 framing (11 bits per byte). */
-constexpr std::chrono::nanoseconds wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
-  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / baud);
-}
 
 /** A virtual board served on a pty or TCP. Create with serve_pty() or serve_tcp(); run the io_context. */
 class board_server : public std::enable_shared_from_this<board_server> {

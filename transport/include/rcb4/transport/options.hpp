@@ -10,6 +10,14 @@
 
 namespace rcb4::transport {
 
+/**
+ * The wire time of @p bytes at @p baud with 8E1 framing: 11 bits a byte (protocol.md §1). What
+ * the client's deadlines and the served board's pacing are made of.
+ */
+constexpr std::chrono::nanoseconds wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
+  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / (baud > 0 ? baud : 1));
+}
+
 /** Direction of a traced frame. */
 enum class direction : std::uint8_t { tx, rx };
 

@@ -126,17 +126,10 @@ class asio_driver {
     if constexpr (has_descriptor) {
       const int fd = s.native_handle();
       if (fd < 0 || !prepare(s, fd)) return write_state::fallback;
-      for (;;) {
-        const ssize_t n = write_nosignal(fd, fd_socket_, a.out);
-        if (n >= 0) {
-          r = finish_io(static_cast<std::size_t>(n), {});
-          return write_state::done;
-        }
-        if (errno == EINTR) continue;
-        if (errno == EAGAIN || errno == EWOULDBLOCK) return write_state::wait;
-        r = finish_io(0, os_error(errno));
-        return write_state::done;
-      }
+      const auto w = try_write(fd, fd_socket_, a.out);
+      if (!w) return write_state::wait;
+      r = finish_io(w->n, w->ec);
+      return write_state::done;
     } else {
       (void)s, (void)a, (void)r;
       return write_state::fallback;

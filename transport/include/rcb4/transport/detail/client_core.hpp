@@ -112,7 +112,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
       if (opt_.direct_io && claim_idle_line()) {
         ec = direct_.run(stream_, machine_, opt_, req, reopen_);
         response r = ec ? response{} : machine_.reply();
-        if (!ec && nack_is_error && r.kind == reply_kind::nack) ec = rcb4::errc::nack;
+        ec = outcome(nack_is_error, ec, r);
         release_line();
         return r;
       }
@@ -262,30 +262,36 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     }
   }
 
-  /** Completes @p p now (dispatch to its executor), from the worker. */
+  /** What the caller sees: for execute, a NACK is errc::nack (the board refused what was to succeed). */
+  static error_code outcome(bool nack_is_error, error_code ec, const response& r) {
+    return !ec && nack_is_error && r.kind == reply_kind::nack ? error_code(rcb4::errc::nack) : ec;
+  }
+
+  /**
+   * Calls @p h with (@p ec, @p r) on its own executor (@p fallback when it has none): inline when
+   * that is this thread's, else posted there, with memory from @p a. Its cancellation slot is
+   * cleared first: a signal emitted later finds nothing to cancel.
+   */
+  static void deliver(handler_type h, boost::asio::cancellation_slot slot, error_code ec, const response& r,
+                      const strand_type& fallback, const handler_allocator<void>& a) {
+    auto ex = boost::asio::get_associated_executor(h, fallback);
+    boost::asio::dispatch(ex, boost::asio::bind_allocator(a, [h = std::move(h), slot, ec, r]() mutable {
+                            if (slot.is_connected()) slot.clear();
+                            std::move(h)(ec, r);
+                          }));
+  }
+
+  /** Completes @p p now, from the worker. */
   void complete_here(pending p, error_code ec, const response& r) {
-    if (!ec && p.nack_is_error && r.kind == reply_kind::nack) ec = rcb4::errc::nack;
-    auto ex = boost::asio::get_associated_executor(p.handler, strand_);
-    boost::asio::dispatch(
-        ex, boost::asio::bind_allocator(asio_.alloc(), [h = std::move(p.handler), slot = p.slot, ec, r]() mutable {
-          if (slot.is_connected()) slot.clear();
-          std::move(h)(ec, r);
-        }));
+    deliver(std::move(p.handler), p.slot, outcome(p.nack_is_error, ec, r), r, strand_, asio_.alloc());
   }
 
   /** Completes @p p with @p ec / @p r on its handler's executor, after the strand's current turn. */
   void complete(pending p, error_code ec, const response& r) {
-    if (!ec && p.nack_is_error && r.kind == reply_kind::nack) ec = rcb4::errc::nack;
     const auto a = asio_.alloc();
-    boost::asio::post(
-        strand_,
-        boost::asio::bind_allocator(a, [h = std::move(p.handler), slot = p.slot, ec, r, s = strand_, a]() mutable {
-          auto ex = boost::asio::get_associated_executor(h, s);
-          boost::asio::dispatch(ex, boost::asio::bind_allocator(a, [h = std::move(h), slot, ec, r]() mutable {
-                                  if (slot.is_connected()) slot.clear();
-                                  std::move(h)(ec, r);
-                                }));
-        }));
+    boost::asio::post(strand_, boost::asio::bind_allocator(
+                                   a, [h = std::move(p.handler), slot = p.slot, ec = outcome(p.nack_is_error, ec, r), r,
+                                       s = strand_, a]() mutable { deliver(std::move(h), slot, ec, r, s, a); }));
   }
 
   bool claim_idle_line() {

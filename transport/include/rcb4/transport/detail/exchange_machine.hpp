@@ -70,11 +70,6 @@ struct io_result {
   bool timed_out = false;  ///< the deadline passed first
 };
 
-/** The wire time of @p frame_bytes + @p reply_bytes at @p baud: 11 bits a byte (8E1). */
-inline clock::duration wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
-  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / std::max(baud, 1u));
-}
-
 /** The policy of one exchange at a time, and the state of the line between them. */
 class exchange_machine {
  public:
@@ -140,11 +135,11 @@ class exchange_machine {
 
  private:
   enum class phase : std::uint8_t { idle, reopen, sync_write, sync_read, write, read, echo_check };
+  // The resync's ping is the short one (protocol.md §4.11): its ACK differs from its frame, so a
+  // loopback plug, which echoes the frame, can never look like a board answering.
+  static constexpr std::array<std::uint8_t, 3> sync_ping{0x03, 0xFE, 0x01};
   static constexpr std::array<std::uint8_t, 4> ping_ack{0x04, 0xFE, 0x06, 0x08};  // protocol.md §4.11
   static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
-
-  clock::duration budget(std::size_t bytes) const { return wire_time(bytes, opt_->baud) + opt_->turnaround; }
-  std::size_t request_bytes() const { return req_.frame.size() + req_.shape.frame_size(); }
 
   void trace(direction d, clock::time_point t, std::span<const std::uint8_t> b) const {
     if (opt_->trace && !b.empty()) opt_->trace(d, t, b);
@@ -189,25 +184,22 @@ class exchange_machine {
   }
 
   action begin_sync(clock::time_point now) {
-    // The short ping (protocol.md §4.11): its ACK differs from its frame, so a loopback plug,
-    // which echoes the frame, can never look like a board answering.
-    static constexpr std::array<std::uint8_t, 3> ping_frame{0x03, 0xFE, 0x01};
     ++n_->resyncs;
-    phase_ = phase::sync_write;
     sync_ = sync_state{};
-    deadline_ = now + budget(ping_frame.size() + ping_ack.size());
-    expected_ = now + wire_time(ping_frame.size() + ping_ack.size(), opt_->baud);
-    out_ = ping_frame;
-    trace(direction::tx, now, out_);
-    return write(out_);
+    return begin_write(phase::sync_write, sync_ping, ping_ack.size(), now);
   }
 
   action begin_exchange(clock::time_point now) {
-    phase_ = phase::write;
     ex_.emplace(req_.frame.bytes(), req_.shape);
-    deadline_ = now + budget(request_bytes());
-    expected_ = now + wire_time(request_bytes(), opt_->baud);
-    out_ = req_.frame.bytes();
+    return begin_write(phase::write, req_.frame.bytes(), req_.shape.frame_size(), now);
+  }
+
+  /** Sends @p frame, whose reply has @p reply_bytes: the reply is due after both have crossed the wire. */
+  action begin_write(phase p, std::span<const std::uint8_t> frame, std::size_t reply_bytes, clock::time_point now) {
+    phase_ = p;
+    expected_ = now + wire_time(frame.size() + reply_bytes, opt_->baud);
+    deadline_ = expected_ + opt_->turnaround;
+    out_ = frame;
     trace(direction::tx, now, out_);
     return write(out_);
   }
@@ -265,7 +257,7 @@ class exchange_machine {
     } else if (n > 0 && sync_.synced) {  // more came after an ACK-like tail: read on to the real one
       sync_.synced = false;
       if (++sync_.resettled > max_resettles) return timed_out(now);
-      deadline_ = now + budget(2 * ping_ack.size());
+      deadline_ = now + wire_time(2 * ping_ack.size(), opt_->baud) + opt_->turnaround;
     }
     return read_into(junk_);
   }
@@ -276,11 +268,10 @@ class exchange_machine {
    * parity), or bytes in no framing the board uses.
    */
   action sync_failed(clock::time_point now) {
-    static constexpr std::array<std::uint8_t, 3> ping_short{0x03, 0xFE, 0x01};
     static constexpr std::array<std::uint8_t, 4> ping_nack{0x04, 0xFE, 0x15, 0x17};  // protocol.md §2.2
     const auto& t = sync_.tail;
     if (sync_.seen == 0 || (sync_.seen >= 4 && t == ping_ack)) return timed_out(now);  // silence, or a late ACK
-    if (sync_.seen >= 3 && std::equal(ping_short.begin(), ping_short.end(), t.begin() + 1)) return finish_echo();
+    if (sync_.seen >= 3 && std::equal(sync_ping.begin(), sync_ping.end(), t.begin() + 1)) return finish_echo();
     if (sync_.seen >= 4 && t == ping_nack) return attempt_failed(rcb4::errc::nack, now);
     if (sync_.seen >= 4 && t[0] == 0x04 && t[1] == 0xFE && (t[2] == 0x06 || t[2] == 0x15))
       return attempt_failed(rcb4::errc::bad_checksum, now);

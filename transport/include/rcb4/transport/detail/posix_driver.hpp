@@ -48,6 +48,20 @@ inline ssize_t write_nosignal(int fd, bool socket, std::span<const std::uint8_t>
 }
 
 /**
+ * One write of @p b to the non-blocking @p fd (see write_nosignal), both drivers' first try:
+ * what it wrote or the error, or nothing when the descriptor has no room yet.
+ */
+inline std::optional<io_result> try_write(int fd, bool socket, std::span<const std::uint8_t> b) noexcept {
+  for (;;) {
+    const ssize_t n = write_nosignal(fd, socket, b);
+    if (n >= 0) return io_result{static_cast<std::size_t>(n)};
+    if (errno == EINTR) continue;
+    if (errno == EAGAIN || errno == EWOULDBLOCK) return std::nullopt;
+    return io_result{0, os_error(errno)};
+  }
+}
+
+/**
  * True when @p fd is a terminal whose reads a VTIME bound limits: not a pseudo-terminal's master
  * side, whose termios settings belong to the slave (a read there would block without limit).
  */
@@ -222,9 +236,7 @@ class posix_driver {
     const int fd = line_fd(s);
     if (fd < 0) return {0, os_error(EBADF)};
     for (;;) {
-      const ssize_t n = write_nosignal(fd, fd_.socket, a.out);
-      if (n >= 0) return {static_cast<std::size_t>(n)};
-      if (errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR) return {0, os_error(errno)};
+      if (auto r = try_write(fd, fd_.socket, a.out)) return *r;
       error_code ec;
       if (!ready_before(fd, POLLOUT, a.deadline, ec)) return {0, {}, true};
       if (ec) return {0, ec};
