@@ -262,3 +262,14 @@ TEST_CASE("a client on a pty's master side (a test harness's setup) still has it
   CHECK(ec == t::transport_errc::timeout);
   CHECK(std::chrono::steady_clock::now() - start < 2s);
 }
+
+TEST_CASE("connect: a missing, empty, non-numeric or too large port is refused, not wrapped", "[transport][line]") {
+  t::io_thread io;
+  for (const char* where : {"127.0.0.1", "127.0.0.1:", "127.0.0.1:http", "127.0.0.1:99999", "127.0.0.1:123456"}) {
+    INFO(where);
+    t::error_code ec;
+    t::connect(io.context(), where, ec);
+    CHECK(ec == std::errc::invalid_argument);
+  }
+  CHECK_THROWS_AS(t::connect(io.context(), "127.0.0.1:99999"), t::system_error);
+}
