@@ -1,131 +1,185 @@
 // rcb4 — the command-line tool: talk to an RCB-4 (or the virtual one), or be one.
+// The commands live one group per file (cmd_*.cpp); this file holds the global options, the
+// parse, and how every failure becomes a message (text or JSON) and an exit code.
 // SPDX-License-Identifier: BSL-1.0
-#include "cli.hpp"
+#include "app.hpp"
 
 #include <rcb4/transport/error.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 
-namespace cli {
-std::string_view device_help();
-}
+#ifndef RCB4_VERSION
+#define RCB4_VERSION "unknown"
+#endif
 
 namespace {
 
-constexpr std::string_view usage_top = R"(rcb4 — talk to KONDO RCB-4 boards (KHR-3HV, KXR), or be one.
-
-usage: rcb4 [global options] COMMAND [ARGS]      (`rcb4 COMMAND --help` for each command)
-
-global options:
-  --device D      /dev/ttyUSB0 (serial), tcp:HOST:PORT (ser2net); default: an in-process
-                  virtual board, so every command works without a robot
-  --baud B        115200, 625000 or 1250000 (default: detected by ping)
-  --timeout MS    turnaround allowance per exchange (default 100)
-  --trace         print every frame on stderr: time, hex, meaning
-  --json          machine-readable output where the output is data
-
-)";
-
-constexpr std::string_view usage_bottom = R"(
-  list            serial ports, recognising KONDO's adapter and FTDI
-  doctor          check permissions, dialout, udev rule, latency timer, baud: each with the fix
-  decode HEX      frames (arguments or stdin) to descriptions
-  encode CMD      a command's frame
-  serve           serve a virtual RCB-4 on a pseudo-terminal or TCP port
+constexpr std::string_view footer = R"(
+Without --device (and without $RCB4_DEVICE) every device command talks to an in-process virtual
+RCB-4, so all of them work without a robot. `rcb4 COMMAND --help` explains each command.
 
 exit codes: 0 ok, 1 the board refused or answered wrongly, 2 usage, 3 device/I/O problem,
-            4 no answer before the deadline
+            4 no answer before the deadline (with --json, failures are {"error", "exit", "hint"})
 )";
 
-/** Exit code and hint for an error from the device. */
-int report(std::string_view cmd, const std::error_code& ec, std::string_view what) {
-  namespace t = rcb4::transport;
-  int code = cli::exit_io;
-  std::string_view hint;
-  if (ec.category() == rcb4::codec_category()) {
-    code = cli::exit_board;
-    if (ec == rcb4::errc::nack) hint = "the board refused the command (range, unallocated servo, or a busy program)";
-  } else if (ec == t::transport_errc::echo) {
-    code = cli::exit_board;
-    hint = "the line returns what is sent: a loopback plug or an echoing adapter, not an RCB-4";
-  } else if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board) {
-    code = cli::exit_timeout;
-    hint = "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud, or `rcb4 doctor`";
-  } else if (ec == t::transport_errc::port_busy) {
-    hint = "another program has the port open (`fuser -v` on the device shows which)";
-  } else if (ec == std::errc::permission_denied) {
-    hint = "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)";
-  } else if (ec == std::errc::no_such_file_or_directory) {
-    hint = "no such device: `rcb4 list` shows the serial ports";
-  } else if (t::is_link_lost(ec)) {
-    hint = "the device went away (unplugged?)";
+/** Prints a failure as text on stderr, or as one JSON object on stdout; returns its exit code. */
+int fail(const cli::globals& g, std::string_view command, const cli::failure& f) {
+  std::string_view what = f.what();
+  // Boost's what() ends with the code's location " [category:value]"; the library's throwing
+  // calls prefix "rcb4 ...:". A person needs the words only.
+  if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']') what = what.substr(0, at);
+  for (std::string_view prefix : {"rcb4 operation: ", "rcb4: "})
+    if (what.substr(0, prefix.size()) == prefix) what.remove_prefix(prefix.size());
+  if (g.json) {
+    cli::json j;
+    j["error"] = what;
+    j["exit"] = f.exit;
+    if (!f.hint.empty()) j["hint"] = f.hint;
+    if (!command.empty()) j["command"] = command;
+    cli::emit(j);
+  } else {
+    fmt::print(stderr, "rcb4{}{}: {}\n", command.empty() ? "" : " ", command, what);
+    if (!f.hint.empty()) fmt::print(stderr, "  {}\n", f.hint);
   }
-  fmt::print(stderr, "rcb4 {}: {}\n", cmd, what);
-  if (!hint.empty()) fmt::print(stderr, "  {}\n", hint);
-  return code;
+  return f.exit;
+}
+
+/** Help whose usage line names the whole command ("rcb4 motion play"), not its last word. */
+class formatter : public CLI::Formatter {
+ public:
+  std::string make_usage(const CLI::App* app, std::string name) const override {
+    for (const CLI::App* p = app->get_parent(); p; p = p->get_parent()) name = p->get_name() + " " + name;
+    return CLI::Formatter::make_usage(app, name);
+  }
+};
+
+/** The deepest command chosen (`servo move`), or the app. */
+const CLI::App* deepest(const CLI::App& app) {
+  const CLI::App* a = &app;
+  while (!a->get_subcommands().empty()) a = a->get_subcommands().front();
+  return a;
+}
+
+/** The command words chosen ("servo move"), for messages. */
+std::string chosen(const CLI::App& app) {
+  std::string out;
+  for (const CLI::App* a = &app; !a->get_subcommands().empty();) {
+    a = a->get_subcommands().front();
+    out += out.empty() ? "" : " ";
+    out += a->get_name();
+  }
+  return out;
+}
+
+/** --json before the command, found before parsing so that a usage error can be JSON too. */
+bool json_requested(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    if (a == "--json") return true;
+    if (a == "--device" || a == "--baud" || a == "--timeout")
+      ++i;
+    else if (a.empty() || a[0] != '-')
+      return false;  // the command: what follows is its own
+  }
+  return false;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string_view> all(argv + 1, argv + argc);
-  cli::globals g;
-  cli::args a;
-  try {
-    // Global options may come before or after the command (not for `serve`, which has its own).
-    std::vector<std::string_view> rest;
-    bool is_serve = false;
-    for (std::size_t i = 0; i < all.size(); ++i) {
-      const auto s = all[i];
-      auto value = [&]() -> std::string_view {
-        if (i + 1 >= all.size()) throw cli::usage_error{fmt::format("{} needs a value", s)};
-        return all[++i];
-      };
-      if (is_serve)
-        rest.push_back(s);
-      else if (s == "--device") {
-        g.device = std::string(value());
-        // An empty device is a mistake (an unset variable in a script), never the virtual board.
-        if (g.device.empty()) throw cli::usage_error{"--device is empty (leave it out for the virtual board)"};
-      } else if (s == "--baud") {
-        const auto b = static_cast<std::uint32_t>(cli::parse_int(value(), "--baud", 1200, 4000000));
-        if (b != 115200 && b != 625000 && b != 1250000)  // the board's COM rates (protocol.md §9)
-          throw cli::usage_error{fmt::format("--baud {}: the RCB-4 speaks 115200, 625000 or 1250000", b)};
-        g.baud = b;
-      } else if (s == "--timeout")
-        g.timeout = std::chrono::milliseconds(cli::parse_int(value(), "--timeout", 1, 600000));
-      else if (s == "--trace")
-        g.trace = true;
-      else if (s == "--json")
-        g.json = true;
-      else {
-        if (rest.empty() && s == "serve") is_serve = true;
-        rest.push_back(s);
-      }
-    }
-    if (rest.empty() || rest[0] == "help" || rest[0] == "--help" || rest[0] == "-h") {
-      fmt::print("{}commands:{}", usage_top, cli::device_help().substr(cli::device_help().find("device commands")));
-      fmt::print("{}", usage_bottom);
-      return rest.empty() ? cli::exit_usage : cli::exit_ok;
-    }
-    a.command = rest[0];
-    a.list.assign(rest.begin() + 1, rest.end());
-    if (a.command == "serve") return cli::serve(a);
-    if (a.command == "list") return cli::list(a, g);
-    if (a.command == "doctor") return cli::doctor(a, g);
-    if (a.command == "decode") return cli::decode(a, g);
-    if (a.command == "encode") return cli::encode(a, g);
-    return cli::device_command(a, g);
-  } catch (const cli::usage_error& e) {
-    fmt::print(stderr, "rcb4{}{}: {}\n(see rcb4 {}--help)\n", a.command.empty() ? "" : " ", a.command, e.message,
-               a.command.empty() ? "" : fmt::format("{} ", a.command));
+  cli::context ctx;
+  CLI::App app{"rcb4 — talk to KONDO RCB-4 boards (KHR-3HV, KXR), or be one.", "rcb4"};
+  app.formatter(std::make_shared<formatter>());
+  app.set_version_flag("--version", std::string("rcb4 ") + RCB4_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough(false);  // global options go before the command
+  auto* device = app.add_option("--device", ctx.g.device,
+                                "serial port (/dev/ttyUSB0, /dev/rcb4-0) or tcp:HOST:PORT (ser2net); "
+                                "default $RCB4_DEVICE, else an in-process virtual board");
+  device->type_name("D");
+  std::uint32_t baud = 0;
+  app.add_option("--baud", baud, "115200, 625000 or 1250000 (default: detected by ping)")
+      ->type_name("B")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            // The board's COM rates (protocol.md §9); anything else cannot reach it.
+            if (v == "115200" || v == "625000" || v == "1250000") return {};
+            return fmt::format("{}: the RCB-4 speaks 115200, 625000 or 1250000", v);
+          },
+          "{115200,625000,1250000}"));
+  long long timeout_ms = 100;
+  app.add_option("--timeout", timeout_ms, "turnaround allowance per exchange in ms (default 100)")
+      ->type_name("MS")
+      ->check(cli::int_range(1, 600000));
+  app.add_flag("--trace", ctx.g.trace, "print every frame on stderr: time, hex, meaning");
+  app.add_flag("--json", ctx.g.json, "machine-readable output: one JSON object (per line for monitor)");
+
+  cli::add_board_commands(app, ctx);
+  cli::add_memory_commands(app, ctx);
+  cli::add_servo_commands(app, ctx);
+  cli::add_sensor_commands(app, ctx);
+  cli::add_motion_commands(app, ctx);
+  cli::add_bench_command(app, ctx);
+  cli::add_host_commands(app, ctx);
+  cli::add_frame_commands(app, ctx);
+  cli::add_serve_command(app, ctx);
+  app.footer(std::string(footer));  // after the commands: they would inherit it
+
+  ctx.g.json = json_requested(argc, argv);
+  if (argc == 1) {
+    fmt::print("{}", app.help());
     return cli::exit_usage;
+  }
+  try {
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::CallForHelp&) {
+      fmt::print("{}", deepest(app)->help());
+      return cli::exit_ok;
+    } catch (const CLI::CallForAllHelp&) {
+      fmt::print("{}", app.help("", CLI::AppFormatMode::All));
+      return cli::exit_ok;
+    } catch (const CLI::CallForVersion&) {
+      fmt::print("rcb4 {}\n", RCB4_VERSION);
+      return cli::exit_ok;
+    } catch (const CLI::ParseError& e) {
+      std::string message = e.what();
+      const std::string words = chosen(app);
+      std::string hint = fmt::format("see rcb4 {}--help", words.empty() ? "" : words + " ");
+      if (dynamic_cast<const CLI::ExtrasError*>(&e) || dynamic_cast<const CLI::RequiredError*>(&e)) {
+        const auto remaining = app.remaining();
+        if (words.empty() && !remaining.empty() && !remaining.front().empty() && remaining.front()[0] != '-') {
+          message = fmt::format("unknown command '{}'", remaining.front());
+          hint = "see rcb4 --help for the commands";
+        }
+        // CLI11 names the arguments it did not expect in its message.
+        const std::string_view said = e.what();
+        for (std::string_view global : {"--device", "--baud", "--timeout", "--trace", "--json"})
+          if (const auto at = said.find(global); at != std::string_view::npos && !words.empty() &&
+                                                 (at + global.size() == said.size() || said[at + global.size()] == ' '))
+            hint =
+                fmt::format("{} is a global option: put it before the command (rcb4 {} {} ...)", global, global, words);
+      }
+      throw cli::failure(cli::exit_usage, message, hint);
+    }
+    // What CLI11 cannot check alone.
+    if (device->count() == 0)
+      if (const char* env = std::getenv("RCB4_DEVICE")) {
+        if (!*env) throw cli::usage_error("RCB4_DEVICE is set but empty (unset it for the virtual board)");
+        ctx.g.device = env;
+      }
+    if (device->count() > 0 && ctx.g.device.empty())
+      throw cli::usage_error("--device is empty (leave it out for the virtual board)");
+    if (baud != 0) ctx.g.baud = baud;
+    ctx.g.timeout = std::chrono::milliseconds(timeout_ms);
+    if (!ctx.action) throw cli::usage_error("no command given");
+    return ctx.action();
+  } catch (const cli::failure& f) {
+    return fail(ctx.g, chosen(app), f);
   } catch (const std::system_error& e) {
-    return report(a.command, e.code(), e.what());
+    return fail(ctx.g, chosen(app), cli::explain(e.code(), e.what()));
   } catch (const boost::system::system_error& e) {
-    // Boost's what() ends with the code's location, " [category:value]": a person needs the words.
-    std::string_view what = e.what();
-    if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']') what = what.substr(0, at);
-    return report(a.command, std::error_code(e.code()), what);
+    return fail(ctx.g, chosen(app), cli::explain(std::error_code(e.code()), e.what()));
   }
 }

@@ -54,10 +54,11 @@ enum class errc : std::uint8_t {
   unsupported_baud,         ///< a COM rate other than 115200, 625000 or 1250000 (protocol.md §9)
   index_out_of_range,       ///< counter, user parameter, timer or AD index past the board's count
   motion_slot_empty,        ///< the motion's ROM slot holds no program (erased: 0xFF)
+  motion_slot_not_a_frame,  ///< the slot's first bytes fail a frame's checksum: another ROM layout?
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::motion_slot_empty;
+inline constexpr errc errc_last = errc::motion_slot_not_a_frame;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -100,6 +101,9 @@ constexpr const char* message(errc e) noexcept {
     case errc::unsupported_baud: return "COM baud must be 115200, 625000 or 1250000";
     case errc::index_out_of_range: return "counter, parameter or timer index out of range";
     case errc::motion_slot_empty: return "the motion slot holds no program (erased ROM): nothing to play";
+    case errc::motion_slot_not_a_frame:
+      return "the motion slot does not start with a valid frame: the program was written for another "
+             "HeartToHeart4 ROM layout (1.3, 2.0-2.1 or 2.2+)?";
   }
   return "unknown rcb4 error";
 }

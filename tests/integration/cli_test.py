@@ -40,7 +40,7 @@ expect_rc(["frobnicate"], 2, "unknown command")
 for sub in ["ping", "version", "config", "read", "write", "servo", "sensors", "monitor", "motion", "bench",
             "list", "doctor", "decode", "encode", "serve"]:
     rc, out, err = run(sub, "--help")
-    check(rc == 0 and "usage" in out, f"{sub} --help")
+    check(rc == 0 and f"Usage: rcb4 {sub}" in out, f"{sub} --help is the command's own help")
 
 # ---- against the in-process virtual board (no --device) --------------------------------------
 expect_ok(["ping"], "ACK from the in-process virtual board")
@@ -55,7 +55,9 @@ expect_rc(["config", "set", "period=12"], 2, "period")
 expect_ok(["read", "ram", "0x0000", "2"], "8B 00")
 expect_ok(["read", "rom", "0x000444", "4"], "0x000444")
 expect_ok(["write", "ram", "0x0400", "12 34 56"], "wrote 3 bytes at 0x000400 in 1 frame")
-expect_rc(["read", "ram", "0x0500", "2"], 2, "outside the memory")
+expect_rc(["read", "ram", "0x0500", "2"], 2, "0x0500 is outside RAM (0x0000..0x048F)")
+expect_rc(["read", "ram", "-5", "2"], 2, "-5 is outside RAM")  # names the memory asked for, not the ROM
+expect_rc(["read", "ram", "0x0480", "32"], 2, "run outside RAM")
 expect_rc(["read", "ics", "0", "2"], 2, "--ics")
 out = expect_ok(["servo", "list"], "ICS")
 check(len(out.strip().splitlines()) == 23, "servo list: 22 servos and a header")
@@ -158,7 +160,7 @@ check(bytes.fromhex("0B 10 01 00 00 00 00 0A 4C 1D 8F") in s.frames[n:], "stand-
 expect_ok(["--device", s.path, "--baud", "1250000", "write", "ram", "0x0400", "AA BB"], "wrote 2 bytes")
 check(bytes.fromhex("09 00 02 00 04 00 AA BB 74") in s.frames, "stand-in received MOV literal -> RAM 0x0400")
 expect_ok(["--device", s.path, "--baud", "1250000", "read", "ram", "0x0400", "2"], "AA BB")
-rc, out, err = run("doctor", "--device", s.path)
+rc, out, err = run("--device", s.path, "doctor")
 check("[ ok ] board answers at" in out, "doctor --device: the board check passes")
 if os.access("/dev/cpu_dma_latency", os.R_OK):
     check("[ -- ] CPU wake-up latency:" in out and "[FAIL] CPU" not in out,
@@ -214,5 +216,130 @@ for i in range(10):
     if rc != 0:
         break
 check(rc == 0 and "ACK" in out, f"a pty left raw 8E1 by another program answers, 10 times in a row (rc {rc}: {err[:160]!r})")
+
+# ---- issue 12: options reach their command, help per command, JSON everywhere -----------------
+t0 = time.monotonic()
+rc, out, err = run("motion", "play", "2", "--wait", "--timeout", "0.2")
+check(rc == 4 and "motion 2 still running after 0.2 s" in err and "program counter" in err and time.monotonic() - t0 < 5,
+      f"motion play --wait --timeout 0.2: the per-command timeout reaches the wait, which says the motion runs on (rc {rc}: {err[:200]!r})")
+rc, out, err = run("motion", "wait", "--timeout", "5")
+check(rc == 0 and "done after" in out, f"motion wait --timeout 5 (seconds, not the global allowance) (rc {rc}: {err[:160]!r})")
+rc, out, err = run("--json", "motion", "play", "2", "--wait", "--timeout", "10")
+j = json.loads(out) if rc == 0 else {}
+check(rc == 0 and j.get("played") == 2 and j["state"]["running"] is False and out.count("\n") == 1,
+      f"--json motion play --wait: one object (rc {rc}: {out[:200]!r})")
+rc, out, err = run("servo", "--help")
+check(rc == 0 and "Usage: rcb4 servo" in out and "move" in out and "monitor" not in out, "servo --help is the servo command's own help")
+rc, out, err = run("motion", "play", "--help")
+check(rc == 0 and "Usage: rcb4 motion play" in out and "--release" in out and "HeartToHeart4 version" in out,
+      "motion play --help explains --release and --layout")
+rc, out, err = run("--version")
+check(rc == 0 and out.startswith("rcb4 "), f"--version ({out!r})")
+rc, out, err = run("bogus")
+check(rc == 2 and "unknown command 'bogus'" in err and "rcb4 bogus --help" not in err, f"rcb4 bogus ({err!r})")
+rc, out, err = run("ping", "--json")
+check(rc == 2 and "global option" in err and "rcb4 --json ping" in err, f"a global option after the command: exit 2, says where it goes ({err!r})")
+p = subprocess.run([RCB4, "ping"], capture_output=True, text=True, env={**os.environ, "RCB4_DEVICE": "/dev/does-not-exist"})
+check(p.returncode == 3 and "/dev/does-not-exist" in p.stderr, f"RCB4_DEVICE names the default device ({p.stderr[:120]!r})")
+p = subprocess.run([RCB4, "ping"], capture_output=True, text=True, env={**os.environ, "RCB4_DEVICE": ""})
+check(p.returncode == 2 and "RCB4_DEVICE is set but empty" in p.stderr, "an empty RCB4_DEVICE is a usage error, not the virtual board")
+p = subprocess.run([RCB4, "--device", s.path, "ping"], capture_output=True, text=True, env={**os.environ, "RCB4_DEVICE": "/dev/does-not-exist"})
+check(p.returncode == 0, "--device wins over RCB4_DEVICE")
+# Errors are JSON under --json: one object on stdout with the exit code.
+for args, code in [(["--json", "--device", "/dev/does-not-exist", "ping"], 3), (["--json", "servo", "move", "0=20000"], 2),
+                   (["--json", "bogus"], 2), (["--json", "--device", silent.path, "--baud", "115200", "--timeout", "20", "ping"], 4),
+                   (["--json", "motion", "play", "120"], 1)]:
+    rc, out, err = run(*args)
+    try:
+        j = json.loads(out)
+    except ValueError:
+        j = {}
+    check(rc == code and j.get("exit") == code and j.get("error"), f"{' '.join(args[1:])}: JSON error with exit {code} (rc {rc}: {out[:160]!r})")
+doc = json.loads(run("--json", "--device", s.path, "doctor")[1])
+check(any(c["ok"] and c["check"].startswith("board answers") for c in doc["checks"]) and "problems" in doc, "doctor --json: an object of checks")
+d = json.loads(run("--json", "decode", "07 0F 00 0A 4C 1D 89")[1])
+check(d["frames"][0]["kind"] == "request" and "SINGLE" in d["frames"][0]["meaning"] and d["bad"] == 0, "decode --json: objects, not strings of text")
+line = json.loads(run("--json", "monitor", "--count", "1")[1])
+check(len(line["ad"]) == 11 and len(line["pa"]) == 4 and line["time"] > 1.7e9 and "elapsed_s" in line, "monitor --json: AD0..AD10, PA1..PA4 and a timestamp")
+
+# ---- decode: the tool's own trace, invalid requests, the checksum it should have had -----------
+rc, out, err = run("--trace", "servo", "get", "0")
+rc2, out2, err2 = run("decode", stdin=err)
+check(rc == 0 and rc2 == 0 and "request" in out2 and "reply" in out2 and "DATA" in out2,
+      f"decode reads the lines of --trace (rc {rc2}: {out2[:300]!r} {err2[:200]!r})")
+rc, out, err = run("decode", "07 0F 24 0A 4C 1D AD")  # SINGLE to ICS 36, checksum right
+check(rc == 1 and "invalid request" in out and "DATA" not in out, f"decode: SINGLE to ICS 36 is an invalid request ({out!r})")
+rc, out, err = run("decode", "07 0F 00 0A 4C 1D 88")
+check(rc == 1 and "0x88" in out and "0x89" in out, f"decode: a bad checksum shows the one expected ({out!r})")
+
+# ---- broken boards (Python stand-ins): each failure named, with its exit code -----------------
+empty = StandIn(mode="empty")
+for args in [["servo", "list"], ["servo", "get", "0"], ["servo", "move", "0=7500"], ["servo", "free"]]:
+    rc, out, err = run("--device", empty.path, "--baud", "1250000", *args)
+    check(rc == 1 and "no servo allocated" in err and "7500" not in out,
+          f"empty allocation table: {' '.join(args)} exits 1 and says so, no numbers (rc {rc}: {out[:80]!r} {err[:120]!r})")
+short = StandIn(mode="short")
+rc, out, err = run("--device", short.path, "--baud", "1250000", "read", "ram", "0", "4")
+check(rc == 1, f"replies of the wrong length: exit 1, a board/line problem (rc {rc}: {err[:200]!r})")
+rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3")
+check(rc == 1 and "holds no program" in err, f"stand-in with an erased ROM: motion play refused (rc {rc}: {err[:160]!r})")
+late = StandIn(mode="late")
+rc, out, err = run("--device", late.path, "--baud", "115200", "--timeout", "1000", "ping")
+check(rc == 0 and " ms" in out and " us" not in out, f"a late reply is timed in ms, not 300000 us ({out!r})")
+rc, out, err = run("--device", late.path, "--baud", "115200", "--timeout", "50", "ping")
+check(rc == 4 and "deadline" in err, f"replies later than the allowance: exit 4 (rc {rc}: {err[:160]!r})")
+import tempfile as _tf
+with _tf.TemporaryDirectory() as tmp:
+    image = os.path.join(tmp, "rom.bin")
+    with open(image, "wb") as f:
+        f.write(bytes(range(256)) * 234 + bytes(96))  # 60,000 bytes
+    dying = StandIn(mode="die", die_after=30)
+    rc, out, err = run("--device", dying.path, "--baud", "1250000", "--timeout", "30", "write", "rom", "0x10000", "--file", image)
+    check(rc == 4 and "write stopped after" in err and "of 60000 bytes" in err and "0x010000.." in err,
+          f"a board that dies mid-write: says how much was written, and where (rc {rc}: {err[:300]!r})")
+    good = StandIn()
+    rc, out, err = run("--device", good.path, "--baud", "1250000", "write", "rom", "0x10000", "--file", image)
+    check(rc == 0 and "wrote 60000 bytes" in out and "%" not in err, f"write --file: 60,000 bytes, no progress in a pipe (rc {rc}: {err[-200:]!r})")
+    # On a terminal, the same transfer shows its progress on stderr.
+    import pty as _pty
+    master, slave = _pty.openpty()
+    p = subprocess.Popen([RCB4, "read", "rom", "0", "0x8000", "--output", os.path.join(tmp, "out.bin")], stdout=subprocess.PIPE, stderr=slave)
+    os.close(slave)
+    shown = b""
+    while True:
+        try:
+            chunk = os.read(master, 4096)
+        except OSError:
+            break
+        if not chunk:
+            break
+        shown += chunk
+    p.wait(timeout=60)
+    check(p.returncode == 0 and b"reading ROM" in shown and b"%" in shown and os.path.getsize(os.path.join(tmp, "out.bin")) == 0x8000,
+          f"read --output on a terminal shows progress and saves the bytes (rc {p.returncode}: {shown[-120:]!r})")
+    rc, out, err = run("serve", "--pty", "--rom", "/proc/no-such-dir/rom.bin")
+    check(rc == 3 and "cannot be written" in err, f"serve --rom into an unwritable place fails at start (rc {rc}: {err[:160]!r})")
+
+# ---- smaller things the trial found ----------------------------------------------------------
+expect_ok(["write", "ram", "0x0400", "12"], "wrote 1 byte at 0x000400 in 1 frame")
+expect_rc(["servo", "move", "--deg", "3=136"], 2, "beyond the servo's turn")
+rc, out, err = run("servo", "move", "3=12000")
+check(rc == 0 and "warning" in err and "3500..11500" in err, "servo move beyond the servo's turn (raw) warns")
+expect_rc(["motion", "play", "2", "--layout", "2.0"], 1, "another")  # 2.0's slot 2 lands inside 2.2's motion 2
+import socket as _socket
+blocker = _socket.socket()
+blocker.bind(("127.0.0.1", 0))
+blocker.listen()
+rc, out, err = run("serve", "--tcp", f"127.0.0.1:{blocker.getsockname()[1]}")
+check(rc == 3 and "cannot serve" in err and "/usr/include" not in err and ".hpp" not in err, f"serve on a port in use: exit 3, no source path ({err!r})")
+blocker.close()
+srv = subprocess.Popen([RCB4, "serve", "--tcp", "127.0.0.1:0"], stdout=subprocess.PIPE, text=True)
+where = srv.stdout.readline().strip()
+rc, out, err = run("--device", "tcp:" + where, "bench", "--count", "5")
+check(rc == 0 and "line rate unknown" in out and "wire limit" not in out, f"bench over TCP without --baud claims no wire limit ({out[:200]!r})")
+rc, out, err = run("--device", "tcp:" + where, "--baud", "1250000", "bench", "--count", "5")
+check(rc == 0 and "wire limit" in out, "bench over TCP with --baud has its wire limit")
+srv.terminate()
+srv.wait(timeout=10)
 
 finish()

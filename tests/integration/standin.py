@@ -6,6 +6,7 @@
 # SPDX-License-Identifier: BSL-1.0
 import os
 import threading
+import time
 import tty
 
 
@@ -13,14 +14,20 @@ class StandIn:
     """A minimal RCB-4 on a pty (protocol.md §2, §4): ping, VERSION, MOV RAM->COM, MOV literal->RAM,
     SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing;
     mode "nack" answers every frame with NACK, "badsum" spoils every reply's checksum, "echo"
-    sends every byte back (a loopback plug), "drop" leaves every third frame unanswered."""
+    sends every byte back (a loopback plug), "drop" leaves every third frame unanswered,
+    "short" answers data requests with a frame one byte shorter (a wrong length), "empty" has an
+    allocation table of zeros (a board nobody set up), "late" answers 300 ms late, "die" stops
+    answering after `die_after` frames (a board that loses power mid-transfer)."""
 
-    def __init__(self, silent=False, mode=None):
+    def __init__(self, silent=False, mode=None, die_after=20):
         self.mode = mode
+        self.die_after = die_after
         self.ram = bytearray(0x490)
         self.ram[0:2] = bytes([0x8B, 0x00])  # config word 0x008B
         for k in range(36):  # allocation table at 0x0044: ICS 0-2 allocated at 0x0090 + 20k
             a = 0x0090 + 20 * k if k < 3 else 0xFFFF
+            if mode == "empty":
+                a = 0
             if k < 35:
                 self.ram[0x44 + 2 * k:0x46 + 2 * k] = a.to_bytes(2, "little")
         for k in range(3):
@@ -36,7 +43,11 @@ class StandIn:
     def reply(self, b):
         if self.mode == "nack":
             b = [0x04, b[1], 0x15]
+        if self.mode == "short" and b[0] > 4:
+            b = [b[0] - 1] + b[1:-1]  # a whole frame, one data byte shorter than the request asked for
         total = (sum(b) + (0x5A if self.mode == "badsum" else 0)) & 0xFF
+        if self.mode == "late":
+            time.sleep(0.3)
         os.write(self.master, bytes(b) + bytes([total]))
 
     def serve(self):
@@ -59,6 +70,8 @@ class StandIn:
                     continue
                 if self.mode == "drop" and self.count % 3 == 0:
                     continue
+                if self.mode == "die" and self.count > self.die_after:
+                    continue
                 cmd = f[1]
                 if cmd == 0xFE:
                     self.reply([0x04, 0xFE, 0x06])
@@ -67,6 +80,11 @@ class StandIn:
                 elif cmd == 0x00 and f[2] == 0x20 and len(f) == 10:  # RAM -> COM
                     a, n = f[6] | f[7] << 8, f[8]
                     self.reply([n + 3, 0x00] + list(self.ram[a:a + n]))
+                elif cmd == 0x00 and f[2] == 0x23 and len(f) == 11:  # ROM -> COM: an erased ROM
+                    n = f[9]
+                    self.reply([n + 3, 0x00] + [0xFF] * n)
+                elif cmd == 0x00 and f[2] == 0x32:  # literal -> ROM (acknowledged, not kept)
+                    self.reply([0x04, 0x00, 0x06])
                 elif cmd == 0x00 and f[2] == 0x02:  # literal -> RAM
                     a = f[3] | f[4] << 8
                     self.ram[a:a + len(f) - 7] = f[6:-1]
@@ -80,7 +98,7 @@ class StandIn:
 if __name__ == "__main__":
     import argparse
     ap = argparse.ArgumentParser(description="an RCB-4 stand-in on a pty")
-    ap.add_argument("--mode", choices=["nack", "badsum", "echo", "drop"])
+    ap.add_argument("--mode", choices=["nack", "badsum", "echo", "drop", "short", "empty", "late", "die"])
     a = ap.parse_args()
     board = StandIn(mode=a.mode)
     board.frames = None  # (a long run keeps no log)

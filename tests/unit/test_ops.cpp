@@ -135,7 +135,7 @@ TEST_CASE("ops: servo states through the allocation table", "[ops][servo]") {
 TEST_CASE("ops: play a motion, follow its state, stop one", "[ops][motion]") {
   board_wire w;
   ops::play_motion play(2);
-  CHECK(run(w, play).size() == 6);  // config, the slot's first bytes, suspend, PC, CALL, resume
+  CHECK(run(w, play).size() == 7);  // config, the slot's first bytes and frame, suspend, PC, CALL, resume
   REQUIRE(play.error() == errc{});
   ops::read_motion_state st;
   run(w, st);
@@ -186,6 +186,19 @@ TEST_CASE("ops: an empty motion slot is refused before anything changes", "[ops]
   CHECK(w.read_word(0) == before);
 }
 
+TEST_CASE("ops: a motion slot of another ROM layout is refused before anything changes", "[ops][motion]") {
+  board_wire w;  // the virtual board's program is HTH4 2.2's: motion 2 starts at 0x0B80 + 2048
+  const auto before = w.read_word(0);
+  // HTH4 2.0's motion 2 is at 0x0BB8 + 2048 = 0x13B8, 56 bytes into 2.2's motion 2: its first byte
+  // looks like a SIZE, but the frame it would start fails its checksum.
+  ops::play_motion play(2, hth4_2_0);
+  const auto sent = run(w, play);
+  CHECK(play.error() == errc::motion_slot_not_a_frame);
+  REQUIRE(sent.size() == 3);  // the config, the slot's first bytes, the frame they announce: no write
+  CHECK(std::get<move>(sent[2]) == move::read_rom(rom_address{0x13B8}, transfer_size{0x4C}).value());
+  CHECK(w.read_word(0) == before);
+}
+
 TEST_CASE("ops: a refused CALL restores the config read at the start", "[ops][motion]") {
   board_wire w;
   const auto before = w.read_word(0);
@@ -199,7 +212,7 @@ TEST_CASE("ops: a refused CALL restores the config read at the start", "[ops][mo
   }
   CHECK(play.error() == errc::nack);
   CHECK(play.refused());
-  REQUIRE(sent.size() == 6);        // ... then the restoring write
+  REQUIRE(sent.size() == 7);        // ... then the restoring write
   CHECK(w.read_word(0) == before);  // the ROM program runs again, as it did
   CHECK(play.value() == before);
 }

@@ -27,10 +27,11 @@ inline std::array<std::uint8_t, 2> le(std::uint16_t v) noexcept {
 
 /**
  * Plays motion @p n (1-based) of @p layout. value(): the config word it wrote last. Before
- * anything changes, the slot's first bytes are read: an erased slot (0xFF, no frame) is
- * errc::motion_slot_empty and nothing is sent. A CALL the board refuses (a full stack, a bad
- * address) does not leave the program stopped: the config word read at the start is written
- * back (the main loop runs again), then error() is errc::nack.
+ * anything changes, the slot's first frame is read: an erased slot (0xFF, no frame) is
+ * errc::motion_slot_empty, a first frame whose checksum fails (the slot address of another
+ * layout lands inside a motion) is errc::motion_slot_not_a_frame, and nothing is sent. A CALL the board refuses (a full
+ * stack, a bad address) does not leave the program stopped: the config word read at the start is written back (the main
+ * loop runs again), then error() is errc::nack.
  */
 class play_motion {
  public:
@@ -52,21 +53,22 @@ class play_motion {
     switch (step_) {
       case 0: return command{move::read_ram(ram::config, 2).value()};
       case 1: return command{move::read_rom(target_, 2).value()};  // (2 bytes: a 1-byte read looks like a NACK)
-      case 2: return command{move::write_ram(ram::config, suspend_).value()};
-      case 3: return command{move::write_ram(ram::program_counter, reset_).value()};
-      case 4: return command{call{target_}};
-      case 5: return command{move::write_ram(ram::config, refused_ ? original_ : resume_).value()};
+      case 2: return command{move::read_rom(target_, first_size_).value()};  // the whole first frame
+      case 3: return command{move::write_ram(ram::config, suspend_).value()};
+      case 4: return command{move::write_ram(ram::program_counter, reset_).value()};
+      case 5: return command{call{target_}};
+      case 6: return command{move::write_ram(ram::config, refused_ ? original_ : resume_).value()};
       default: return std::nullopt;
     }
   }
   /** Takes a reply. */
   void on_reply(const reply& r) {
-    if (step_ == 4 && r.is_nack()) {  // refused: restore the program's config, then report it
+    if (step_ == 5 && r.is_nack()) {  // refused: restore the program's config, then report it
       refused_ = true;
       ++step_;
       return;
     }
-    if ((error_ = detail::check_reply(r, step_ <= 1, 2)) != errc{}) return;
+    if ((error_ = detail::check_reply(r, step_ <= 2, step_ == 2 ? first_size_.value() : 2)) != errc{}) return;
     if (step_ == 0) {
       original_ = detail::le(r.u16());
       auto c = config_word::decode(r.u16());
@@ -78,8 +80,17 @@ class play_motion {
       resume_ = detail::le(resumed_);
     } else if (step_ == 1) {
       const std::uint8_t size = r.bytes()[0];  // a program starts with a frame: SIZE 3..128 (§2.1)
-      if (size < 3 || size > max_request_size) error_ = errc::motion_slot_empty;
-    } else if (step_ == 5 && refused_) {
+      if (size < 3 || size > max_request_size)
+        error_ = errc::motion_slot_empty;
+      else
+        first_size_ = transfer_size::make(size).value();
+    } else if (step_ == 2) {
+      // Its SUM is the low byte of the sum of the bytes before it (§2.1), as in every frame.
+      unsigned sum = 0;
+      const auto b = r.bytes();
+      for (std::size_t i = 0; i + 1 < b.size(); ++i) sum += b[i];
+      if ((sum & 0xFFu) != b.back()) error_ = errc::motion_slot_not_a_frame;
+    } else if (step_ == 6 && refused_) {
       resumed_ = static_cast<std::uint16_t>(original_[0] | (original_[1] << 8));
       error_ = errc::nack;
     }
@@ -99,6 +110,7 @@ class play_motion {
   std::array<std::uint8_t, 2> suspend_{}, resume_{}, original_{};
   std::array<std::uint8_t, 10> reset_{};
   std::uint16_t resumed_ = 0;
+  transfer_size first_size_{};
   unsigned step_ = 0;
   bool refused_ = false;
   errc error_{};

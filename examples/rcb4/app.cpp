@@ -1,6 +1,7 @@
-// rcb4 command-line tool: parsing helpers, the device session, the frame printer.
+// rcb4 command-line tool: what the commands share: parsing helpers, output, the device session,
+// progress, the trace printer, and how errors become exit codes.
 // SPDX-License-Identifier: BSL-1.0
-#include "cli.hpp"
+#include "app.hpp"
 
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
@@ -10,9 +11,46 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 
 namespace cli {
+
+void emit(const json& j) {
+  fmt::print("{}\n", j.dump());
+  std::fflush(stdout);
+}
+
+std::string plural(std::size_t n, std::string_view word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
+
+std::string duration_text(std::chrono::duration<double, std::micro> d) {
+  const double us = d.count();
+  if (us < 10'000) return fmt::format("{:.0f} us", us);
+  if (us < 10'000'000) return fmt::format("{:.1f} ms", us / 1000);
+  return fmt::format("{:.2f} s", us / 1e6);
+}
+
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const auto& w : words) {
+    if (!out.empty()) out += ' ';
+    out += w;
+  }
+  return out;
+}
+
+CLI::Validator int_range(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        try {
+          parse_int(s, "value", lo, hi);
+        } catch (const usage_error& e) {
+          return std::string(e.what()).substr(7);  // without "value: "
+        }
+        return {};
+      },
+      fmt::format("{}..{}", lo, hi));
+}
 
 long long parse_int(std::string_view s, std::string_view what, long long lo, long long hi) {
   const std::string_view original = s;
@@ -98,7 +136,7 @@ session::session(const globals& g) {
     where_ = path;
   }
   if (path.rfind("tcp:", 0) == 0) {
-    serial_ = false;
+    rate_known_ = g.baud.has_value();
     baud = g.baud.value_or(115200);  // the bridge's line rate is unknown: the slowest gives safe deadlines
     auto socket = rcb4::transport::connect(io_.context(), path.substr(4));
     opt.baud = baud;
@@ -113,7 +151,7 @@ session::session(const globals& g) {
     how.trace = opt.trace;  // --trace shows the detection's frames too
     rcb4::transport::error_code ec;
     baud = rcb4::transport::detect_baud(io_.context(), path, ec, how);
-    if (ec) throw rcb4::transport::system_error(ec, path);
+    if (ec) throw rcb4::transport::system_error(ec, path);  // names the device
   }
   auto port = rcb4::transport::open_serial(io_.context(), path, baud);
   opt.baud = baud;
@@ -157,47 +195,63 @@ std::vector<std::string> frame_printer::received(std::span<const std::uint8_t> b
   return lines;
 }
 
-std::vector<std::string> frame_printer::decode(std::span<const std::uint8_t> bytes) {
-  std::vector<std::string> lines;
-  std::size_t at = 0;
-  while (at < bytes.size()) {
-    const auto rest = bytes.subspan(at);
-    // After a request, its reply is expected (its shape resolves the 1-byte-data/NACK look-alike).
-    if (expected_) {
-      const auto rep = rcb4::parse_reply(rest, *expected_);
-      if (rep.status == rcb4::parse_status::complete) {
-        lines.push_back(fmt::format("reply    {:<30}  {}", rcb4::hex(rest.first(rep.consumed)), rep.value));
-        at += rep.consumed;
-        expected_.reset();
-        continue;
-      }
-    }
-    const auto req = rcb4::parse_command(rest);
-    if (req.status == rcb4::parse_status::complete) {
-      lines.push_back(fmt::format("request  {:<30}  {}", rcb4::hex(rest.first(req.consumed)), req.value));
-      expected_ = rcb4::expected_reply(req.value);
-      at += req.consumed;
-      continue;
-    }
-    const auto rep = rcb4::parse_reply_frame(rest);
-    if (rep.status == rcb4::parse_status::complete) {
-      lines.push_back(fmt::format("reply    {:<30}  {}", rcb4::hex(rest.first(rep.consumed)), rep.value));
-      at += rep.consumed;
-      expected_.reset();
-      continue;
-    }
-    if (req.status == rcb4::parse_status::need_more && rep.status == rcb4::parse_status::need_more) {
-      lines.push_back(
-          fmt::format("partial  {:<30}  (incomplete frame: {} more bytes expected)", rcb4::hex(rest), req.needed));
-      break;
-    }
-    const std::size_t n = std::min(rest.size(), std::max<std::size_t>(1, req.consumed));
-    lines.push_back(fmt::format("invalid  {:<30}  ({})", rcb4::hex(rest.first(n)),
-                                rcb4::message(req.status == rcb4::parse_status::error ? req.error : rep.error)));
-    at += n;
-    expected_.reset();
+// ---------------------------------------------------------------------------------------------
+
+progress::progress(std::string label, std::size_t total, bool json_output)
+    : label_(std::move(label)), total_(total), on_(!json_output && ::isatty(STDERR_FILENO)) {}
+
+progress::~progress() {
+  if (on_ && last_ != std::chrono::steady_clock::time_point{}) fmt::print(stderr, "\r{:70}\r", "");
+}
+
+void progress::update(std::size_t done) {
+  if (!on_) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (done < total_ && now - last_ < std::chrono::milliseconds(100)) return;
+  last_ = now;
+  fmt::print(stderr, "\r  {}  {}/{}  {:3.0f} %", label_, done, total_,
+             total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0);
+  std::fflush(stderr);
+}
+
+void on_device(CLI::App* cmd, context& ctx, std::function<int(session&)> f) {
+  cmd->callback([&ctx, f = std::move(f)] {
+    ctx.action = [&ctx, f] {
+      session s(ctx.g);
+      return f(s);
+    };
+  });
+}
+
+void on_run(CLI::App* cmd, context& ctx, std::function<int()> f) {
+  cmd->callback([&ctx, f = std::move(f)] { ctx.action = f; });
+}
+
+failure explain(const std::error_code& ec, std::string_view what) {
+  namespace t = rcb4::transport;
+  if (ec.category() == rcb4::codec_category()) {
+    if (ec == rcb4::errc::nack)
+      return {exit_board, std::string(what),
+              "the board refused the command (range, unallocated servo, or a busy program)"};
+    if (ec == rcb4::errc::bad_checksum)
+      return {exit_board, std::string(what), "replies fail their checksum: a wrong baud or parity, or a noisy line"};
+    return {exit_board, std::string(what)};
   }
-  return lines;
+  if (ec == t::transport_errc::echo)
+    return {exit_board, std::string(what),
+            "the line returns what is sent: a loopback plug or an echoing adapter, not an RCB-4"};
+  if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board)
+    return {exit_timeout, std::string(what),
+            "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud, or `rcb4 doctor`"};
+  if (ec == t::transport_errc::port_busy)
+    return {exit_io, std::string(what), "another program has the port open (`fuser -v` on the device shows which)"};
+  if (ec == std::errc::permission_denied)
+    return {exit_io, std::string(what),
+            "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)"};
+  if (ec == std::errc::no_such_file_or_directory)
+    return {exit_io, std::string(what), "no such device: `rcb4 list` shows the serial ports"};
+  if (t::is_link_lost(ec)) return {exit_io, std::string(what), "the device went away (unplugged?)"};
+  return {exit_io, std::string(what)};
 }
 
 }  // namespace cli

@@ -1,0 +1,200 @@
+// rcb4 command-line tool: what every command file shares. The options and help of each command
+// are declared with CLI11 in its own file (cmd_*.cpp); JSON goes through nlohmann::json.
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <rcb4/board/virtual_board.hpp>
+#include <rcb4/fmt.hpp>
+#include <rcb4/ops.hpp>
+#include <rcb4/transport/board_server.hpp>
+#include <rcb4/transport/client.hpp>
+#include <rcb4/transport/operations.hpp>
+
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+#include <boost/asio/posix/stream_descriptor.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cli {
+
+// Exit codes, one per kind of failure (in `rcb4 --help` and the README).
+inline constexpr int exit_ok = 0;       ///< done
+inline constexpr int exit_board = 1;    ///< the board refused (NACK) or answered something malformed
+inline constexpr int exit_usage = 2;    ///< bad command line
+inline constexpr int exit_io = 3;       ///< device missing, busy, not permitted, unplugged
+inline constexpr int exit_timeout = 4;  ///< no answer before the deadline (silent board, wrong baud)
+
+/** A failure a command reports itself: its message, exit code and a hint with the fix. */
+struct failure : std::runtime_error {
+  /** @p message says what went wrong; @p hint (optional) what to do about it. */
+  failure(int code, std::string message, std::string fix = {})
+      : std::runtime_error(std::move(message)), exit(code), hint(std::move(fix)) {}
+  int exit;          ///< one of the exit codes above
+  std::string hint;  ///< the fix, or empty
+};
+
+/** A command-line mistake found after parsing (a value out of range, a servo given twice): exit 2. */
+struct usage_error : failure {
+  /** @p message names the argument and what is wrong with it. */
+  explicit usage_error(std::string message) : failure(exit_usage, std::move(message)) {}
+};
+
+/** The global options (before the command). */
+struct globals {
+  std::string device;                      ///< empty: the in-process virtual board
+  std::optional<std::uint32_t> baud;       ///< empty: detect (serial) or unknown (TCP)
+  std::chrono::milliseconds timeout{100};  ///< turnaround allowance per exchange
+  bool trace = false;                      ///< print every frame with its meaning
+  bool json = false;                       ///< machine-readable output
+};
+
+/** Keys in the order they were set: output reads as it is documented. */
+using json = nlohmann::ordered_json;
+
+/** Prints @p j on one line of stdout. */
+void emit(const json& j);
+
+/** "1 byte", "2 bytes". */
+std::string plural(std::size_t n, std::string_view word);
+/** A duration for people: "640 us", "501.1 ms", "12.34 s". */
+std::string duration_text(std::chrono::duration<double, std::micro> d);
+
+/** Integer from decimal, 0x hex or negative decimal, checked against [lo, hi]. */
+long long parse_int(std::string_view s, std::string_view what, long long lo, long long hi);
+/** Hex bytes: "07 0F 00", "070F00", "0x07,0x0F" (separators: space, comma, colon). */
+std::vector<std::uint8_t> parse_hex(std::string_view s, std::string_view what);
+/** Joins command-line words with spaces (hex bytes given as several words). */
+std::string join(const std::vector<std::string>& words);
+/** A run-time value as a checked codec value; a bad one is a usage error naming @p what. */
+template <class T>
+T checked(long long v, std::string_view what) {
+  auto r = T::make(v);
+  if (!r) throw usage_error(fmt::format("{}: {} ({})", what, v, rcb4::message(r.error())));
+  return *r;
+}
+
+/** Validator for a CLI11 option holding an integer in [lo, hi] (decimal or 0x hex). */
+CLI::Validator int_range(long long lo, long long hi);
+
+using stream = boost::asio::posix::stream_descriptor;
+using client = rcb4::transport::basic_client<stream>;
+
+/**
+ * An open device: a serial port, a TCP bridge, or (no --device) an in-process virtual board on
+ * a pseudo-terminal. Owns the io thread, the client, and the board when there is one.
+ */
+class session {
+ public:
+  /** Opens what @p g names (detecting the baud on a serial port without --baud); throws on failure. */
+  explicit session(const globals& g);
+  ~session();
+  session(const session&) = delete;
+  session& operator=(const session&) = delete;
+
+  /** The client. */
+  client& c() { return *client_; }
+  /** The baud in use for deadlines (the wire rate on a serial port). */
+  std::uint32_t baud() const noexcept { return client_->options().baud; }
+  /** True when the line rate is known (serial, or TCP with --baud): wire limits mean something. */
+  bool rate_known() const noexcept { return rate_known_; }
+  /** What was opened, for messages. */
+  const std::string& where() const noexcept { return where_; }
+  /** True when no --device was given. */
+  bool is_virtual() const noexcept { return board_ != nullptr; }
+  /** Runs @p op; throws rcb4::transport::system_error on failure. */
+  template <rcb4::ops::Operation Op>
+  auto run(Op op) {
+    return rcb4::transport::run(*client_, std::move(op));
+  }
+  /**
+   * Runs @p op exchange by exchange, calling @p step after each reply (progress); sets @p ec
+   * and returns on the first failure, with what the operation did so far left in @p op.
+   */
+  template <rcb4::ops::Operation Op, class Step>
+  void run_steps(Op& op, rcb4::transport::error_code& ec, Step&& step) {
+    ec.clear();
+    while (auto cmd = op.next()) {
+      const auto r = client_->exchange(*cmd, ec);
+      if (ec) return;
+      op.on_reply(r.view());
+      step();
+    }
+    if (op.error() != rcb4::errc{}) ec = op.error();
+  }
+
+ private:
+  std::unique_ptr<rcb4::board::virtual_board> board_;
+  std::unique_ptr<rcb4::transport::io_thread> board_io_;
+  std::shared_ptr<rcb4::transport::board_server> server_;
+  rcb4::transport::io_thread io_;
+  std::unique_ptr<client> client_;
+  std::string where_;
+  bool rate_known_ = true;
+};
+
+/** A progress line on stderr for long work: only on a terminal, never under --json. */
+class progress {
+ public:
+  /** Shows "@p label  done/total" while work goes on, when stderr is a terminal and not @p json. */
+  progress(std::string label, std::size_t total, bool json_output);
+  ~progress();
+  progress(const progress&) = delete;
+  progress& operator=(const progress&) = delete;
+  /** @p done of the total are finished (redrawn at most 10 times a second). */
+  void update(std::size_t done);
+
+ private:
+  std::string label_;
+  std::size_t total_;
+  bool on_;
+  std::chrono::steady_clock::time_point last_{};
+};
+
+/** Prints a frame for --trace and `decode`: direction, hex, meaning. */
+class frame_printer {
+ public:
+  /** A request the host sent; remembers its reply shape for the next reply. */
+  std::string request(std::span<const std::uint8_t> frame);
+  /** Bytes the host received; returns one line per complete frame. */
+  std::vector<std::string> received(std::span<const std::uint8_t> bytes);
+
+ private:
+  std::vector<std::uint8_t> rx_;
+  std::optional<rcb4::reply_shape> expected_;
+};
+
+/** Where the parsed command leaves its work: run once parsing is done (errors of use come first). */
+struct context {
+  globals g;                    ///< the global options
+  std::function<int()> action;  ///< the chosen command
+};
+
+/** Makes @p cmd, when chosen, open a session and run @p f on it. */
+void on_device(CLI::App* cmd, context& ctx, std::function<int(session&)> f);
+/** Makes @p cmd, when chosen, run @p f (no device opened). */
+void on_run(CLI::App* cmd, context& ctx, std::function<int()> f);
+
+// The command groups, one file each.
+void add_board_commands(CLI::App& app, context& ctx);   ///< ping, version, config (cmd_board.cpp)
+void add_memory_commands(CLI::App& app, context& ctx);  ///< read, write (cmd_memory.cpp)
+void add_servo_commands(CLI::App& app, context& ctx);   ///< servo … (cmd_servo.cpp)
+void add_sensor_commands(CLI::App& app, context& ctx);  ///< sensors, monitor (cmd_sensors.cpp)
+void add_motion_commands(CLI::App& app, context& ctx);  ///< motion … (cmd_motion.cpp)
+void add_bench_command(CLI::App& app, context& ctx);    ///< bench (cmd_bench.cpp)
+void add_host_commands(CLI::App& app, context& ctx);    ///< list, doctor (cmd_host.cpp)
+void add_frame_commands(CLI::App& app, context& ctx);   ///< decode, encode (cmd_frames.cpp)
+void add_serve_command(CLI::App& app, context& ctx);    ///< serve (cmd_serve.cpp)
+
+/** Exit code and hint for an error from the device or the board. */
+failure explain(const std::error_code& ec, std::string_view what);
+
+}  // namespace cli

@@ -1,0 +1,186 @@
+// rcb4 command-line tool: motion play|stop|resume|status|wait (the ROM program's motions, §8).
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <unistd.h>
+
+namespace cli {
+namespace {
+
+/** Options the motion commands share. */
+struct motion_options {
+  std::string layout = "2.2";  ///< the HTH4 version that wrote the board's program
+  double timeout_s = 60;       ///< how long --wait / wait waits
+};
+
+const rcb4::rom_layout& layout_of(const motion_options& o) {
+  if (o.layout == "1.3") return rcb4::hth4_1_3;
+  if (o.layout == "2.0" || o.layout == "2.1") return rcb4::hth4_2_0;
+  return rcb4::hth4_2_2;
+}
+
+void add_layout(CLI::App* cmd, motion_options& o) {
+  cmd->add_option("--layout", o.layout,
+                  "the HeartToHeart4 version that wrote the board's program: 2.2 (default; also later versions), "
+                  "2.0 or 2.1, 1.3. It sets where the motions start in ROM (protocol.md §8)")
+      ->check(CLI::IsMember({"1.3", "2.0", "2.1", "2.2"}));
+}
+
+void add_timeout(CLI::App* cmd, motion_options& o, std::string_view what) {
+  cmd->add_option("--timeout", o.timeout_s, fmt::format("seconds to wait {} (default 60)", what))
+      ->type_name("S")
+      ->check(CLI::Range(0.001, 3600.0));
+}
+
+json state_json(const rcb4::ops::motion_state& st) {
+  json j;
+  j["running"] = st.running;
+  j["motion"] = st.motion ? json(*st.motion) : json(nullptr);
+  j["program_counter"] = st.program_counter;
+  return j;
+}
+
+std::string state_text(const rcb4::ops::motion_state& st) {
+  if (!st.running) return fmt::format("no motion running (program counter 0x{:06X})", st.program_counter);
+  if (st.motion) return fmt::format("motion {} running (program counter 0x{:06X})", *st.motion, st.program_counter);
+  return fmt::format("a program is running outside the motion slots (program counter 0x{:06X})", st.program_counter);
+}
+
+/** Waits until no motion runs; returns the seconds waited and the last state. */
+std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options& o, const globals& g) {
+  const bool tty = ::isatty(STDERR_FILENO) && !g.json;
+  const auto start = std::chrono::steady_clock::now();
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  std::optional<rcb4::ops::motion_state> last;
+  rcb4::transport::error_code ec;
+  const auto st = rcb4::transport::wait_motion(
+      s.c(), std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::duration<double>(o.timeout_s)), ec,
+      [&](const rcb4::ops::motion_state& m) {
+        last = m;
+        if (tty && m.running)
+          fmt::print(stderr, "\r  motion {} running  {:5.1f} s  pc 0x{:06X} ",
+                     m.motion ? fmt::format("{}", *m.motion) : "?", seconds(), m.program_counter);
+      },
+      layout_of(o));
+  if (tty) fmt::print(stderr, "\r{:60}\r", "");
+  // The board answered every poll, but the motion outlived the wait: say that, not "no reply".
+  if (ec == rcb4::transport::transport_errc::timeout && last && last->running && seconds() >= o.timeout_s)
+    throw failure(exit_timeout,
+                  fmt::format("{} still running after {:.1f} s (program counter 0x{:06X})",
+                              last->motion ? fmt::format("motion {}", *last->motion) : std::string("a program"),
+                              seconds(), last->program_counter),
+                  "wait longer (--timeout S), or stop it: rcb4 motion stop");
+  if (ec) throw rcb4::transport::system_error(ec, "motion wait");
+  return {seconds(), st};
+}
+
+int play(session& s, unsigned n, bool release, bool and_wait, const motion_options& o, const globals& g) {
+  const auto& layout = layout_of(o);
+  s.run(rcb4::ops::play_motion(n, layout, release ? rcb4::ops::servo_power::release : rcb4::ops::servo_power::keep));
+  if (!and_wait) {
+    if (g.json) {
+      json j;
+      j["playing"] = n;
+      j["layout"] = layout.name;
+      emit(j);
+    } else {
+      fmt::print("playing motion {} ({} layout)\n", n, layout.name);
+    }
+    return exit_ok;
+  }
+  if (!g.json) fmt::print("playing motion {} ({} layout)\n", n, layout.name);
+  const auto [t, st] = wait(s, o, g);
+  if (g.json) {
+    json j;
+    j["played"] = n;
+    j["layout"] = layout.name;
+    j["seconds"] = std::round(t * 10) / 10;
+    j["state"] = state_json(st);
+    emit(j);
+  } else {
+    fmt::print("done after {:.1f} s\n{}\n", t, state_text(st));
+  }
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_motion_commands(CLI::App& app, context& ctx) {
+  auto* motion = app.add_subcommand("motion", "the motions in ROM that the board's program plays (HTH4 projects)");
+  motion->require_subcommand(1);
+
+  auto* play_cmd = motion->add_subcommand("play", "play motion N: suspend, reset, CALL, resume (KONDO's four steps)");
+  struct play_options {
+    motion_options m;
+    unsigned n = 0;
+    bool wait = false, release = false;
+  };
+  auto po = std::make_shared<play_options>();
+  play_cmd->add_option("N", po->n, "the motion's number (1..120; 1..50 for --layout 1.3)")->required();
+  play_cmd->add_flag("--wait", po->wait, "wait until it ends, with a progress line on a terminal");
+  add_timeout(play_cmd, po->m, "with --wait");
+  add_layout(play_cmd, po->m);
+  play_cmd->add_flag("--release", po->release,
+                     "turn the servo outputs off while the program is suspended (KONDO's libraries do; "
+                     "by default they keep holding, so the robot does not go limp between motions)");
+  play_cmd->callback([&ctx, po] {
+    const auto& layout = layout_of(po->m);
+    if (po->n < 1 || po->n > layout.motion_count)
+      throw usage_error(
+          fmt::format("motion number: {} is outside 1..{} ({} layout)", po->n, layout.motion_count, layout.name));
+    ctx.action = [&ctx, po] {
+      session s(ctx.g);
+      return play(s, po->n, po->release, po->wait, po->m, ctx.g);
+    };
+  });
+
+  auto* stop = motion->add_subcommand("stop", "suspend the ROM program (motion resume continues it)");
+  on_device(stop, ctx, [&ctx](session& s) {
+    s.run(rcb4::ops::stop_motion{});
+    if (ctx.g.json)
+      emit(json{{"stopped", true}});
+    else
+      fmt::print("stopped (the ROM program is suspended; rcb4 motion resume continues it)\n");
+    return exit_ok;
+  });
+
+  auto* resume = motion->add_subcommand("resume", "let the ROM program run again");
+  on_device(resume, ctx, [&ctx](session& s) {
+    s.run(rcb4::ops::resume_motion());
+    if (ctx.g.json)
+      emit(json{{"resumed", true}});
+    else
+      fmt::print("resumed\n");
+    return exit_ok;
+  });
+
+  auto* status = motion->add_subcommand("status", "whether a motion runs, which, and the program counter");
+  auto so = std::make_shared<motion_options>();
+  add_layout(status, *so);
+  on_device(status, ctx, [&ctx, so](session& s) {
+    const auto st = s.run(rcb4::ops::read_motion_state(layout_of(*so)));
+    if (ctx.g.json)
+      emit(state_json(st));
+    else
+      fmt::print("{}\n", state_text(st));
+    return exit_ok;
+  });
+
+  auto* wait_cmd = motion->add_subcommand("wait", "wait until no motion runs, with a progress line on a terminal");
+  auto wo = std::make_shared<motion_options>();
+  add_timeout(wait_cmd, *wo, "");
+  add_layout(wait_cmd, *wo);
+  on_device(wait_cmd, ctx, [&ctx, wo](session& s) {
+    const auto [t, st] = wait(s, *wo, ctx.g);
+    if (ctx.g.json) {
+      json j = state_json(st);
+      j["seconds"] = std::round(t * 10) / 10;
+      emit(j);
+    } else {
+      fmt::print("done after {:.1f} s\n{}\n", t, state_text(st));
+    }
+    return exit_ok;
+  });
+}
+
+}  // namespace cli

@@ -1,0 +1,146 @@
+// rcb4 command-line tool: sensors (one reading) and monitor (a live table, or JSON lines).
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <thread>
+
+namespace cli {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::vector<std::string> button_names(std::uint16_t b) {
+  static constexpr std::pair<rcb4::krr_button, std::string_view> names[] = {
+      {rcb4::krr_button::up, "up"},         {rcb4::krr_button::down, "down"},     {rcb4::krr_button::right, "right"},
+      {rcb4::krr_button::left, "left"},     {rcb4::krr_button::triangle, "tri"},  {rcb4::krr_button::cross, "cross"},
+      {rcb4::krr_button::circle, "circle"}, {rcb4::krr_button::square, "square"}, {rcb4::krr_button::s1, "S1"},
+      {rcb4::krr_button::s2, "S2"},         {rcb4::krr_button::s3, "S3"},         {rcb4::krr_button::s4, "S4"}};
+  std::vector<std::string> out;
+  for (const auto& [bit, name] : names)
+    if (b & static_cast<std::uint16_t>(bit)) out.emplace_back(name);
+  return out;
+}
+
+std::string buttons_text(std::uint16_t b) {
+  std::string out;
+  for (const auto& n : button_names(b)) out += (out.empty() ? "" : "+") + n;
+  return out.empty() ? "none" : out;
+}
+
+/** One reading of everything a KHR carries on its inputs. */
+struct reading {
+  rcb4::ops::analog_inputs analog;
+  rcb4::ops::pio_state pio;
+  rcb4::ops::receiver_state rx;
+};
+
+reading read_all(session& s) {
+  return {s.run(rcb4::ops::read_analog{}), s.run(rcb4::ops::read_pio{}), s.run(rcb4::ops::read_receiver{})};
+}
+
+/** The sensor fields of `sensors --json` and of each `monitor --json` line. */
+void put(json& j, const reading& r) {
+  j["battery_volts"] = std::round(r.analog.battery_volts * 100) / 100;
+  j["ad"] = r.analog.values;
+  j["pio_direction"] = r.pio.direction;
+  j["pio_value"] = r.pio.value;
+  j["buttons"] = r.rx.buttons;
+  j["button_names"] = button_names(r.rx.buttons);
+  j["pa"] = r.rx.analog;
+}
+
+int sensors(session& s, const globals& g) {
+  const auto r = read_all(s);
+  if (g.json) {
+    json j;
+    put(j, r);
+    emit(j);
+    return exit_ok;
+  }
+  fmt::print("battery   {:.2f} V (AD0 = {})\n", r.analog.battery_volts, r.analog.values[0]);
+  for (std::size_t k = 1; k < r.analog.values.size(); ++k) fmt::print("AD{:<2}      {}\n", k, r.analog.values[k]);
+  fmt::print("PIO       direction 0b{:010b} (1 = output), levels 0b{:010b}\n", r.pio.direction, r.pio.value);
+  fmt::print("buttons   0x{:04X} {}\n", r.rx.buttons, buttons_text(r.rx.buttons));
+  fmt::print("PA1..PA4  {} {} {} {}\n", r.rx.analog[0], r.rx.analog[1], r.rx.analog[2], r.rx.analog[3]);
+  return exit_ok;
+}
+
+std::atomic<bool> interrupted{false};
+extern "C" void on_signal(int) { interrupted = true; }
+
+std::string position_text(std::uint16_t v) {
+  if (v == rcb4::servo_position::free_value) return "FREE";
+  if (v == rcb4::servo_position::hold_value) return "HOLD";
+  const auto p = rcb4::servo_position::make(v);
+  if (!p) return fmt::format("0x{:04X}", v);
+  return fmt::format("{:5} {:+6.1f}", v, rcb4::ops::to_degrees(*p));
+}
+
+int monitor(session& s, long long hz, long long count, const globals& g) {
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  const bool tty = ::isatty(STDOUT_FILENO) && !g.json;
+  const auto period = std::chrono::microseconds(1000000 / hz);
+  const auto start = std::chrono::steady_clock::now();
+  auto next = start;
+  for (long long n = 0; !interrupted && (count == 0 || n < count); ++n) {
+    const auto states = s.run(rcb4::ops::read_servo_states(rcb4::ops::link_cost::at(s.baud(), 1ms)));
+    const auto r = read_all(s);
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - start).count();
+    if (g.json) {
+      json j;
+      j["sample"] = n;
+      j["time"] =
+          std::round(std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count() *
+                     1000) /
+          1000;
+      j["elapsed_s"] = std::round(elapsed * 1000) / 1000;
+      put(j, r);
+      json pos = json::object();
+      for (const auto& st : states) pos[std::to_string(st.ics.value())] = st.position;
+      j["positions"] = pos;
+      emit(j);
+    } else {
+      if (tty) fmt::print("\x1b[H\x1b[2J");
+      fmt::print("rcb4 monitor  {}  {} Hz  sample {}  {:.1f} s  (Ctrl-C to stop)\n", s.where(), hz, n, elapsed);
+      fmt::print("battery {:.2f} V   buttons {}   PA1..4 {} {} {} {}   PIO 0b{:010b}\n", r.analog.battery_volts,
+                 buttons_text(r.rx.buttons), r.rx.analog[0], r.rx.analog[1], r.rx.analog[2], r.rx.analog[3],
+                 r.pio.value);
+      fmt::print("AD1..10");
+      for (std::size_t k = 1; k < r.analog.values.size(); ++k) fmt::print(" {:4}", r.analog.values[k]);
+      fmt::print("\n");
+      for (std::size_t i = 0; i < states.size(); ++i)
+        fmt::print("ICS {:>2} {:<14}{}", states[i].ics.value(), position_text(states[i].position),
+                   i % 4 == 3 || i + 1 == states.size() ? "\n" : "  ");
+      std::fflush(stdout);
+    }
+    next += period;
+    std::this_thread::sleep_until(next);  // the sampling rate the user asked for
+  }
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_sensor_commands(CLI::App& app, context& ctx) {
+  auto* sensors_cmd = app.add_subcommand("sensors", "AD0..AD10, battery volts, PIO, receiver buttons and PA1..PA4");
+  on_device(sensors_cmd, ctx, [&ctx](session& s) { return sensors(s, ctx.g); });
+
+  auto* monitor_cmd =
+      app.add_subcommand("monitor", "a live table of servo positions and sensors until Ctrl-C (--json: a line each)");
+  auto hz = std::make_shared<long long>(5);
+  auto count = std::make_shared<long long>(0);
+  monitor_cmd->add_option("--hz", *hz, "samples per second (default 5)")->check(int_range(1, 1000));
+  monitor_cmd->add_option("--count", *count, "stop after N samples (default: until Ctrl-C)")
+      ->check(int_range(1, 100000000));
+  on_device(monitor_cmd, ctx, [&ctx, hz, count](session& s) { return monitor(s, *hz, *count, ctx.g); });
+}
+
+}  // namespace cli

@@ -1,0 +1,136 @@
+// rcb4 command-line tool: `rcb4 serve`, a virtual RCB-4 board on a pty or TCP.
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <boost/asio.hpp>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace cli {
+namespace {
+
+struct serve_options {
+  bool pty = false;
+  std::string tcp;
+  std::string rom_path;
+  long long latency_us = 0;
+  std::string series = "reboot", shift = "measured";
+  long long servos = 22;
+  rcb4::transport::serve_options serve;
+  rcb4::board::options board;
+};
+
+/** Fails now (not at exit, after a session's work) when the ROM image could not be saved. */
+void check_rom_writable(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p(path);
+  const bool exists = fs::exists(p, ec);
+  const auto dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (exists ? ::access(path.c_str(), W_OK) != 0 : ::access(dir.c_str(), W_OK) != 0)
+    throw failure(exit_io,
+                  fmt::format("--rom {}: cannot be written ({}), so the ROM could not be saved at exit", path,
+                              std::strerror(errno)),
+                  "name a file in a directory you may write");
+}
+
+int serve(serve_options& o, const globals& g) {
+  using namespace rcb4;
+  o.serve.latency = std::chrono::microseconds(o.latency_us);
+  o.board.series = o.series == "execute" ? board::series_behaviour::execute : board::series_behaviour::reboot;
+  o.board.shift = o.shift == "manual" ? shift_encoding::kondo_manual : shift_encoding::measured_2015;
+  o.board.servo_count = static_cast<std::uint8_t>(o.servos);
+
+  std::optional<boost::asio::ip::tcp::endpoint> endpoint;
+  if (!o.tcp.empty()) {
+    const auto colon = o.tcp.rfind(':');
+    if (colon == std::string::npos) throw usage_error(fmt::format("--tcp: expected HOST:PORT, not '{}'", o.tcp));
+    const auto port = parse_int(std::string_view(o.tcp).substr(colon + 1), "--tcp port", 0, 65535);
+    boost::system::error_code ec;
+    const auto address = boost::asio::ip::make_address(o.tcp.substr(0, colon), ec);
+    if (ec) throw usage_error(fmt::format("--tcp: '{}' is not an IP address", o.tcp.substr(0, colon)));
+    endpoint.emplace(address, static_cast<std::uint16_t>(port));
+  }
+
+  board::virtual_board board(o.board);
+  if (!o.rom_path.empty()) {
+    check_rom_writable(o.rom_path);
+    std::ifstream f(o.rom_path, std::ios::binary);
+    if (f) {
+      std::vector<std::uint8_t> image{std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+      if (!board.load_rom(image))
+        throw failure(exit_io, fmt::format("{}: a ROM image is exactly {} bytes, this file has {}", o.rom_path,
+                                           rom_size, image.size()));
+    }
+  }
+
+  boost::asio::io_context io;
+  std::shared_ptr<transport::board_server> server;
+  try {
+    if (o.pty)
+      server = transport::board_server::serve_pty(io, board, o.serve);
+    else
+      server = transport::board_server::serve_tcp(io, board, *endpoint, o.serve);
+  } catch (const boost::system::system_error& e) {
+    throw failure(exit_io, fmt::format("cannot serve on {}: {}", o.pty ? "a pty" : o.tcp, e.code().message()));
+  } catch (const std::system_error& e) {
+    throw failure(exit_io, fmt::format("cannot serve on {}: {}", o.pty ? "a pty" : o.tcp, e.code().message()));
+  }
+  if (g.json)
+    emit(json{{"where", server->where()}});
+  else
+    fmt::print("{}\n", server->where());
+  std::fflush(stdout);
+
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code&, int) { server->stop(); });
+  io.run();
+
+  if (!o.rom_path.empty()) {
+    std::ofstream f(o.rom_path, std::ios::binary | std::ios::trunc);
+    f.write(reinterpret_cast<const char*>(board.rom().data()), static_cast<std::streamsize>(board.rom().size()));
+    if (!f) throw failure(exit_io, fmt::format("could not save the ROM to {}", o.rom_path));
+  }
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app, context& ctx) {
+  auto* cmd = app.add_subcommand("serve", "serve a virtual RCB-4 on a pseudo-terminal or a TCP port");
+  auto o = std::make_shared<serve_options>();
+  auto* pty = cmd->add_flag("--pty", o->pty, "serve on a new pseudo-terminal");
+  auto* tcp =
+      cmd->add_option("--tcp", o->tcp, "serve on TCP, one client at a time (e.g. 127.0.0.1:0)")->type_name("HOST:PORT");
+  pty->excludes(tcp);
+  cmd->add_flag("--pace", o->serve.pace, "deliver replies at the board's line rate (11 bits per byte, 8E1)");
+  cmd->add_option("--latency", o->latency_us, "extra microseconds before each reply (USB adapter, turnaround)")
+      ->type_name("US")
+      ->check(int_range(0, 10'000'000));
+  cmd->add_option("--rom", o->rom_path, "load the 256 KiB ROM image from FILE if it exists; save it there on exit")
+      ->type_name("FILE");
+  cmd->add_option("--series", o->series, "SERIES (0x11): reboot (default, as measured in 2015) or execute")
+      ->check(CLI::IsMember({"reboot", "execute"}));
+  cmd->add_option("--shift", o->shift, "SHIFT counts: measured (default, 2015 report) or manual (KONDO's manual)")
+      ->check(CLI::IsMember({"measured", "manual"}));
+  cmd->add_flag("--arith-to-com", o->board.allow_arith_to_com,
+                "answer arithmetic with COM as destination (refused by default)");
+  cmd->add_flag("--strict-timing", o->board.strict_timing, "drop frames whose bytes arrive more than 150 us apart");
+  cmd->add_option("--servos", o->servos, "allocated servo slots ICS 0..N-1 (default 22; ICS 35 is the receiver)")
+      ->check(int_range(0, 35));
+  cmd->footer(
+      "Serves an emulated RCB-4HV until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"
+      "the /dev/pts/N path for --pty (open it with the usual serial settings), or HOST:PORT for --tcp\n"
+      "(port 0 picks a free one; loopback unless you name another address).");
+  cmd->callback([&ctx, o] {
+    if (!o->pty && o->tcp.empty()) throw usage_error("serve: give --pty or --tcp HOST:PORT");
+    ctx.action = [&ctx, o] { return serve(*o, ctx.g); };
+  });
+}
+
+}  // namespace cli
