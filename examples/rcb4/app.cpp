@@ -7,6 +7,7 @@
 #include <rcb4/transport/serial.hpp>
 #include <rcb4/transport/tcp.hpp>
 
+#include <termios.h>
 #include <unistd.h>
 
 #include <cctype>
@@ -110,6 +111,7 @@ stream adopt(boost::asio::io_context& io, int fd) {
 }  // namespace
 
 session::session(const globals& g) {
+  if (!g.empty_device.empty()) throw usage_error(g.empty_device);
   rcb4::transport::client_options opt;
   opt.turnaround = g.timeout;
   if (g.trace) {
@@ -136,6 +138,12 @@ session::session(const globals& g) {
     where_ = path;
   }
   if (path.rfind("tcp:", 0) == 0) {
+    // A malformed address is the user's mistake (exit 2), not the device's.
+    const auto rest = std::string_view(path).substr(4);
+    const auto colon = rest.rfind(':');
+    if (colon == std::string_view::npos || colon == 0)
+      throw usage_error(fmt::format("--device {}: expected tcp:HOST:PORT", path));
+    parse_int(rest.substr(colon + 1), "--device port", 1, 65535);
     rate_known_ = g.baud.has_value();
     baud = g.baud.value_or(115200);  // the bridge's line rate is unknown: the slowest gives safe deadlines
     auto socket = rcb4::transport::connect(io_.context(), path.substr(4));
@@ -154,8 +162,13 @@ session::session(const globals& g) {
     if (ec) throw rcb4::transport::system_error(ec, path);  // names the device
   }
   auto port = rcb4::transport::open_serial(io_.context(), path, baud);
+  // Bytes a previous program left behind (a late reply to a request it gave up on) must not
+  // answer our first request: drop what has arrived, then a ping puts the line in step (a stale
+  // reply that comes later fails the ping's shape, and the client resynchronises).
+  ::tcflush(port.native_handle(), TCIFLUSH);
   opt.baud = baud;
   client_ = std::make_unique<client>(adopt(io_.context(), port.native_handle()), opt);
+  client_->execute(rcb4::ping{rcb4::ping_form::short_});
 }
 
 session::~session() {
@@ -200,8 +213,11 @@ std::vector<std::string> frame_printer::received(std::span<const std::uint8_t> b
 progress::progress(std::string label, std::size_t total, bool json_output)
     : label_(std::move(label)), total_(total), on_(!json_output && ::isatty(STDERR_FILENO)) {}
 
-progress::~progress() {
+progress::~progress() { finish(); }
+
+void progress::finish() {
   if (on_ && last_ != std::chrono::steady_clock::time_point{}) fmt::print(stderr, "\r{:70}\r", "");
+  last_ = {};
 }
 
 void progress::update(std::size_t done) {
@@ -242,7 +258,8 @@ failure explain(const std::error_code& ec, std::string_view what) {
             "the line returns what is sent: a loopback plug or an echoing adapter, not an RCB-4"};
   if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board)
     return {exit_timeout, std::string(what),
-            "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud, or `rcb4 doctor`"};
+            "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud; a slow link (a bridge, "
+            "a busy adapter) needs a longer --timeout MS; `rcb4 doctor` checks the rest"};
   if (ec == t::transport_errc::port_busy)
     return {exit_io, std::string(what), "another program has the port open (`fuser -v` on the device shows which)"};
   if (ec == std::errc::permission_denied)

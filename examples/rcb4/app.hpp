@@ -36,10 +36,11 @@ inline constexpr int exit_timeout = 4;  ///< no answer before the deadline (sile
 /** A failure a command reports itself: its message, exit code and a hint with the fix. */
 struct failure : std::runtime_error {
   /** @p message says what went wrong; @p hint (optional) what to do about it. */
-  failure(int code, std::string message, std::string fix = {})
-      : std::runtime_error(std::move(message)), exit(code), hint(std::move(fix)) {}
-  int exit;          ///< one of the exit codes above
-  std::string hint;  ///< the fix, or empty
+  failure(int code, std::string message, std::string fix = {}, nlohmann::ordered_json fields = {})
+      : std::runtime_error(std::move(message)), exit(code), hint(std::move(fix)), extra(std::move(fields)) {}
+  int exit;                      ///< one of the exit codes above
+  std::string hint;              ///< the fix, or empty
+  nlohmann::ordered_json extra;  ///< facts for --json (e.g. how far a transfer got), or null
 };
 
 /** A command-line mistake found after parsing (a value out of range, a servo given twice): exit 2. */
@@ -55,6 +56,7 @@ struct globals {
   std::chrono::milliseconds timeout{100};  ///< turnaround allowance per exchange
   bool trace = false;                      ///< print every frame with its meaning
   bool json = false;                       ///< machine-readable output
+  std::string empty_device;                ///< why the device is empty when it was named so (checked on open)
 };
 
 /** Keys in the order they were set: output reads as it is documented. */
@@ -151,6 +153,8 @@ class progress {
   progress& operator=(const progress&) = delete;
   /** @p done of the total are finished (redrawn at most 10 times a second). */
   void update(std::size_t done);
+  /** Clears the line (before the result is printed). */
+  void finish();
 
  private:
   std::string label_;

@@ -28,7 +28,7 @@ int ping(session& s, long long n, const globals& g) {
   if (g.json) {
     json j;
     j["where"] = s.where();
-    j["baud"] = s.baud();
+    j["baud"] = s.rate_known() ? json(s.baud()) : json(nullptr);
     j["count"] = n;
     j["min_us"] = std::round(*lo * 10) / 10;
     j["avg_us"] = std::round(avg * 10) / 10;
@@ -41,8 +41,9 @@ int ping(session& s, long long n, const globals& g) {
   }
   using us_t = std::chrono::duration<double, std::micro>;
   if (n > 1)
-    fmt::print("{}: min {}, avg {}, max {} ({} baud)\n", plural(static_cast<std::size_t>(n), "ping"),
-               duration_text(us_t(*lo)), duration_text(us_t(avg)), duration_text(us_t(*hi)), s.baud());
+    fmt::print("{}: min {}, avg {}, max {} ({})\n", plural(static_cast<std::size_t>(n), "ping"),
+               duration_text(us_t(*lo)), duration_text(us_t(avg)), duration_text(us_t(*hi)),
+               s.rate_known() ? fmt::format("{} baud", s.baud()) : std::string("line rate unknown"));
   if (retries > 0 || timeouts > 0)
     fmt::print("{} {} after {} ({}): replies come late or get lost\n", retries, retries == 1 ? "retry" : "retries",
                plural(timeouts, "timeout"), plural(resyncs, "resync"));
@@ -108,7 +109,7 @@ void print_config(const rcb4::config_word& c, const globals& g) {
 bool parse_on_off(std::string_view key, std::string_view v) {
   if (v == "on" || v == "1" || v == "true") return true;
   if (v == "off" || v == "0" || v == "false") return false;
-  throw usage_error(fmt::format("config set {}: expected on or off, not '{}'", key, v));
+  throw usage_error(fmt::format("{}: expected on or off, not '{}'", key, v));
 }
 
 rcb4::baud_code parse_baud(std::string_view key, std::string_view v) {
@@ -127,13 +128,13 @@ struct config_changes {
                                                 "led", "period",  "ics-baud",    "baud"};
     for (const auto& kv : pairs) {
       const auto eq = kv.find('=');
-      if (eq == std::string::npos) throw usage_error(fmt::format("config set: expected KEY=VALUE, not '{}'", kv));
+      if (eq == std::string::npos) throw usage_error(fmt::format("expected KEY=VALUE, not '{}'", kv));
       const auto key = kv.substr(0, eq), value = kv.substr(eq + 1);
       if (std::find(std::begin(keys), std::end(keys), key) == std::end(keys))
-        throw usage_error(fmt::format("config set: unknown key '{}' (see rcb4 config set --help)", key));
+        throw usage_error(fmt::format("unknown key '{}' (see rcb4 config set --help)", key));
       const auto same = [&](const auto& f) { return f.first == key; };
       if ((key == "baud" && baud) || std::any_of(fields.begin(), fields.end(), same))
-        throw usage_error(fmt::format("config set: {} is given twice", key));
+        throw usage_error(fmt::format("{} is given twice", key));
       if (key == "baud")
         baud = rcb4::bits_per_second(parse_baud("baud", value));
       else
@@ -152,8 +153,9 @@ struct config_changes {
       if (key == "led") c.led = parse_on_off(key, value);
       if (key == "ics-baud") c.ics_baud = parse_baud("ics-baud", value);
       if (key == "period") {
-        const auto ms = parse_int(value, "period", 10, 25);
-        if (ms % 5 != 0) throw usage_error("period: 10, 15, 20 or 25 (ms)");
+        const auto ms = parse_int(value, "period", 0, 1000);
+        if (ms < 10 || ms > 25 || ms % 5 != 0)
+          throw usage_error(fmt::format("period: {} ms is not one of 10, 15, 20 or 25", value));
         c.period = static_cast<rcb4::output_period>((ms - 10) / 5);
       }
     }
@@ -163,6 +165,10 @@ struct config_changes {
 int config_set(session& s, const config_changes& ch, const globals& g) {
   if (!ch.fields.empty()) s.run(rcb4::ops::update_config([&](rcb4::config_word& c) { ch.apply(c); }));
   if (ch.baud) {
+    if (!s.rate_known())
+      throw failure(exit_usage, "config set baud=: the line's rate is unknown here (a TCP bridge)",
+                    "the board would switch, but the bridge's serial side would not follow: set the bridge's rate "
+                    "yourself, or change the baud on a serial port");
     rcb4::transport::switch_baud(s.c(), *ch.baud);  // the board, then this port, then a ping
     if (!g.json) fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *ch.baud);
   }

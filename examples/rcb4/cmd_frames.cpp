@@ -308,7 +308,7 @@ void add_frame_commands(CLI::App& app, context& ctx) {
       "Exit code 1 when a frame is invalid or incomplete.\n"
       "examples:\n"
       "  rcb4 decode 07 0F 00 0A 4C 1D 89\n"
-      "  echo \"0A 00 20 00 00 00 00 02 2C\" | rcb4 decode\n"
+      "  echo \"0A 00 20 00 00 00 00 00 02 2C\" | rcb4 decode\n"
       "  rcb4 --trace servo list 2>&1 >/dev/null | rcb4 decode");
   on_run(decode_cmd, ctx, [&ctx, words] { return decode(*words, ctx.g); });
 

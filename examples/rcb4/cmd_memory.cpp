@@ -2,6 +2,9 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 
@@ -67,28 +70,41 @@ void hexdump(std::uint32_t base, std::span<const std::uint8_t> b) {
   if (writing && done > 0)
     hint = fmt::format(
         "{} 0x{:06X}..0x{:06X} holds the new bytes; from 0x{:06X} on, the old ones (the piece in "
-        "flight may have landed). {}",
+        "flight may have landed).\n  {}",
         name, addr, addr + done - 1, addr + done, f.hint);
+  json facts;
+  facts["address"] = addr;
+  facts[writing ? "written" : "read"] = done;
+  facts["total"] = total;
   throw failure(
       f.exit, fmt::format("{} stopped after {} of {} bytes: {}", writing ? "write" : "read", done, total, ec.message()),
-      hint);
+      hint, facts);
 }
 
 int read(session& s, const memory_options& o, std::size_t len, const std::string& output, const globals& g) {
   const auto t = target(o);
   const auto addr = address(t, o.address);
   check_range(t, addr, len);
+  std::ofstream out;  // opened before the transfer: a bad path fails now, not after the whole read
+  if (!output.empty() && output != "-") {
+    out.open(output, std::ios::binary | std::ios::trunc);
+    if (!out) throw failure(exit_io, fmt::format("--output {}: cannot create it: {}", output, std::strerror(errno)));
+  }
   rcb4::ops::read_memory op(t.kind, addr, len, t.ics);
   progress bar(fmt::format("reading {}", t.name), len, g.json);
   rcb4::transport::error_code ec;
   s.run_steps(op, ec, [&] { bar.update(op.value().size()); });
   if (ec) partial(ec, false, op.value().size(), len, addr, t.name);
+  bar.finish();
   const auto& bytes = op.value();
+  if (output == "-") {  // binary to stdout, for a pipe
+    std::fwrite(bytes.data(), 1, bytes.size(), stdout);
+    return exit_ok;
+  }
   if (!output.empty()) {
-    std::ofstream f(output, std::ios::binary | std::ios::trunc);
-    f.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    f.close();
-    if (!f) throw failure(exit_io, fmt::format("--output {}: cannot write it", output));
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw failure(exit_io, fmt::format("--output {}: writing it failed: {}", output, std::strerror(errno)));
     if (g.json) {
       json j;
       j["memory"] = o.kind;
@@ -124,6 +140,7 @@ int write(session& s, const memory_options& o, const std::vector<std::uint8_t>& 
     bar.update(op.value());
   });
   if (ec) partial(ec, true, op.value(), bytes.size(), addr, t.name);
+  bar.finish();
   if (g.json) {
     json j;
     j["memory"] = o.kind;
@@ -154,8 +171,10 @@ void add_memory_commands(CLI::App& app, context& ctx) {
   auto output = std::make_shared<std::string>();
   memory_options_of(read_cmd, *ro);
   read_cmd->add_option("LEN", *len, "bytes to read: decimal or 0x hex")->required();
-  read_cmd->add_option("--output", *output, "write the bytes to FILE (binary) instead of a hex dump")
-      ->type_name("FILE");
+  read_cmd->add_option("--output", *output, "write the bytes to FILE (binary; - for stdout) instead of a hex dump")
+      ->type_name("FILE")
+      ->check(CLI::Validator(
+          [](std::string& v) { return v.empty() ? std::string("an empty file name") : std::string(); }, ""));
   read_cmd->footer(
       "examples:\n  rcb4 read ram 0x0000 2                      the config word\n"
       "  rcb4 read rom 0 0x40000 --output rom.bin    the whole ROM (progress on a terminal)");

@@ -26,8 +26,8 @@ void add_layout(CLI::App* cmd, motion_options& o) {
       ->check(CLI::IsMember({"1.3", "2.0", "2.1", "2.2"}));
 }
 
-void add_timeout(CLI::App* cmd, motion_options& o, std::string_view what) {
-  cmd->add_option("--timeout", o.timeout_s, fmt::format("seconds to wait {} (default 60)", what))
+CLI::Option* add_timeout(CLI::App* cmd, motion_options& o, std::string_view what) {
+  return cmd->add_option("--timeout", o.timeout_s, fmt::format("seconds to wait{} (default 60)", what))
       ->type_name("S")
       ->check(CLI::Range(0.001, 3600.0));
 }
@@ -112,13 +112,13 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   auto* play_cmd = motion->add_subcommand("play", "play motion N: suspend, reset, CALL, resume (KONDO's four steps)");
   struct play_options {
     motion_options m;
-    unsigned n = 0;
+    long long n = 0;
     bool wait = false, release = false;
   };
   auto po = std::make_shared<play_options>();
   play_cmd->add_option("N", po->n, "the motion's number (1..120; 1..50 for --layout 1.3)")->required();
-  play_cmd->add_flag("--wait", po->wait, "wait until it ends, with a progress line on a terminal");
-  add_timeout(play_cmd, po->m, "with --wait");
+  auto* wait_flag = play_cmd->add_flag("--wait", po->wait, "wait until it ends, with a progress line on a terminal");
+  add_timeout(play_cmd, po->m, " with --wait")->needs(wait_flag);
   add_layout(play_cmd, po->m);
   play_cmd->add_flag("--release", po->release,
                      "turn the servo outputs off while the program is suspended (KONDO's libraries do; "
@@ -130,7 +130,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
           fmt::format("motion number: {} is outside 1..{} ({} layout)", po->n, layout.motion_count, layout.name));
     ctx.action = [&ctx, po] {
       session s(ctx.g);
-      return play(s, po->n, po->release, po->wait, po->m, ctx.g);
+      return play(s, static_cast<unsigned>(po->n), po->release, po->wait, po->m, ctx.g);
     };
   });
 

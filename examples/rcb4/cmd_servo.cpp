@@ -82,13 +82,13 @@ std::vector<rcb4::ops::servo_state> states_of(session& s) {
 }
 
 /** Refuses (usage, nothing sent) servos the board has no block for: the board would ignore them. */
-void require_allocated(session& s, const std::optional<rcb4::servo_mask>& m, std::string_view cmd) {
+void require_allocated(session& s, const std::optional<rcb4::servo_mask>& m) {
   const auto slots = s.run(rcb4::ops::scan_servos{});
   if (slots.empty()) no_servos();
   if (!m) return;
   for (auto n : *m)
     if (std::none_of(slots.begin(), slots.end(), [&](const auto& slot) { return slot.ics == n; }))
-      throw usage_error(fmt::format("{}: ICS {} has no servo allocated (see rcb4 servo list)", cmd, n.value()));
+      throw usage_error(fmt::format("ICS {} has no servo allocated (see rcb4 servo list)", n.value()));
 }
 
 json ics_list(const rcb4::servo_mask& done) {
@@ -103,7 +103,7 @@ rcb4::servo_set<rcb4::timed_position> targets_of(const std::vector<std::string>&
   rcb4::servo_set<rcb4::timed_position> targets;
   for (const std::string_view item : items) {
     const auto eq = item.find('=');
-    if (eq == std::string_view::npos) throw usage_error(fmt::format("servo move: expected ICS=POS, not '{}'", item));
+    if (eq == std::string_view::npos) throw usage_error(fmt::format("expected ICS=POS, not '{}'", item));
     const auto ics = checked<ics_number>(parse_int(item.substr(0, eq), "ICS", 0, 35), "ICS");
     auto rest = item.substr(eq + 1);
     long long frames = frames_default;
@@ -117,10 +117,10 @@ rcb4::servo_set<rcb4::timed_position> targets_of(const std::vector<std::string>&
       char* end = nullptr;
       const double d = std::strtod(str.c_str(), &end);
       if (str.empty() || end != str.c_str() + str.size() || !std::isfinite(d))
-        throw usage_error(fmt::format("servo move: '{}' is not degrees", rest));
+        throw usage_error(fmt::format("'{}' is not degrees", rest));
       if (std::abs(d) > servo_degrees)
-        throw usage_error(fmt::format("servo move: ICS {}: {} degrees is beyond the servo's turn (±{:.0f})",
-                                      ics.value(), rest, servo_degrees));
+        throw usage_error(
+            fmt::format("ICS {}: {} degrees is beyond the servo's turn (±{:.0f})", ics.value(), rest, servo_degrees));
       pos = *rcb4::ops::from_degrees(d);
     } else {
       pos = checked<rcb4::servo_position>(parse_int(rest, "POS", 0, 16383), "POS");
@@ -128,7 +128,7 @@ rcb4::servo_set<rcb4::timed_position> targets_of(const std::vector<std::string>&
         fmt::print(stderr, "rcb4 servo move: warning: ICS {}: {} is beyond a KRS servo's turn ({}..{}, ±135 deg)\n",
                    ics.value(), pos.value(), servo_low, servo_high);
     }
-    if (targets.contains(ics)) throw usage_error(fmt::format("servo move: ICS {} is given twice", ics.value()));
+    if (targets.contains(ics)) throw usage_error(fmt::format("ICS {} is given twice", ics.value()));
     targets.insert(ics, {pos, checked<rcb4::frames>(frames, "FRAMES")});
   }
   return targets;
@@ -151,13 +151,13 @@ void add_servo_commands(CLI::App& app, context& ctx) {
   get->add_option("ICS", *get_ics, "ICS numbers (0..35)")->required();
   get->callback([&ctx, get_ics] {
     const auto want = servos_of(*get_ics);
-    if (!want) throw usage_error("servo get: name the servos (ICS numbers; servo list shows all)");
+    if (!want) throw usage_error("name the servos (ICS numbers; servo list shows all)");
     ctx.action = [&ctx, want = *want] {
       session s(ctx.g);
       auto states = states_of(s);
       for (auto n : want)
         if (std::none_of(states.begin(), states.end(), [&](const auto& st) { return st.ics == n; }))
-          throw usage_error(fmt::format("servo get: ICS {} has no servo allocated (see rcb4 servo list)", n.value()));
+          throw usage_error(fmt::format("ICS {} has no servo allocated (see rcb4 servo list)", n.value()));
       std::erase_if(states, [&](const auto& st) { return !want.contains(st.ics); });
       print_states(states, ctx.g);
       return exit_ok;
@@ -183,7 +183,7 @@ void add_servo_commands(CLI::App& app, context& ctx) {
     auto targets = targets_of(mo->items, mo->frames, mo->degrees);
     ctx.action = [&ctx, targets] {
       session s(ctx.g);
-      require_allocated(s, targets.mask(), "servo move");
+      require_allocated(s, targets.mask());
       const auto moved = s.run(rcb4::ops::move_servos(targets));
       if (ctx.g.json) {
         json j;
@@ -205,8 +205,7 @@ void add_servo_commands(CLI::App& app, context& ctx) {
       const auto mask = servos_of(*which);
       ctx.action = [&ctx, mask, free] {
         session s(ctx.g);
-        const std::string name = free ? "servo free" : "servo hold";
-        require_allocated(s, mask, name);
+        require_allocated(s, mask);
         const auto done =
             s.run(rcb4::ops::set_servo_power(free ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, mask));
         if (ctx.g.json) {
@@ -235,7 +234,7 @@ void add_servo_commands(CLI::App& app, context& ctx) {
       ctx.action = [&ctx, mask, v, speed] {
         session s(ctx.g);
         const std::string name = speed ? "speed" : "stretch";
-        require_allocated(s, mask, "servo " + name);
+        require_allocated(s, mask);
         const auto done =
             s.run(rcb4::ops::set_servo_param(speed ? rcb4::param_kind::speed : rcb4::param_kind::stretch, v, mask));
         if (ctx.g.json) {

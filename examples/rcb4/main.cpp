@@ -37,6 +37,8 @@ int fail(const cli::globals& g, std::string_view command, const cli::failure& f)
     j["exit"] = f.exit;
     if (!f.hint.empty()) j["hint"] = f.hint;
     if (!command.empty()) j["command"] = command;
+    if (f.extra.is_object())
+      for (const auto& [k, v] : f.extra.items()) j[k] = v;
     cli::emit(j);
   } else {
     fmt::print(stderr, "rcb4{}{}: {}\n", command.empty() ? "" : " ", command, what);
@@ -141,7 +143,10 @@ int main(int argc, char** argv) {
       fmt::print("{}", app.help("", CLI::AppFormatMode::All));
       return cli::exit_ok;
     } catch (const CLI::CallForVersion&) {
-      fmt::print("rcb4 {}\n", RCB4_VERSION);
+      if (ctx.g.json)
+        cli::emit(cli::json{{"version", RCB4_VERSION}});
+      else
+        fmt::print("rcb4 {}\n", RCB4_VERSION);
       return cli::exit_ok;
     } catch (const CLI::ParseError& e) {
       std::string message = e.what();
@@ -166,11 +171,11 @@ int main(int argc, char** argv) {
     // What CLI11 cannot check alone.
     if (device->count() == 0)
       if (const char* env = std::getenv("RCB4_DEVICE")) {
-        if (!*env) throw cli::usage_error("RCB4_DEVICE is set but empty (unset it for the virtual board)");
+        if (!*env) ctx.g.empty_device = "RCB4_DEVICE is set but empty (unset it for the virtual board)";
         ctx.g.device = env;
       }
     if (device->count() > 0 && ctx.g.device.empty())
-      throw cli::usage_error("--device is empty (leave it out for the virtual board)");
+      ctx.g.empty_device = "--device is empty (leave it out for the virtual board)";  // refused where a device opens
     if (baud != 0) ctx.g.baud = baud;
     ctx.g.timeout = std::chrono::milliseconds(timeout_ms);
     if (!ctx.action) throw cli::usage_error("no command given");

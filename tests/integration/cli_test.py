@@ -342,4 +342,28 @@ check(rc == 0 and "wire limit" in out, "bench over TCP with --baud has its wire 
 srv.terminate()
 srv.wait(timeout=10)
 
+# ---- found by a newcomer trial ---------------------------------------------------------------
+# A late reply to a request the previous program gave up on must not answer the next program's.
+slow = subprocess.Popen([RCB4, "serve", "--pty", "--latency", "150000"], stdout=subprocess.PIPE, text=True)
+slow_path = slow.stdout.readline().strip()
+wrong = 0
+for i in range(3):
+    rc_a, _, _ = run("--device", slow_path, "--baud", "1250000", "--timeout", "20", "read", "ram", "0", "4")
+    rc, out, err = run("--device", slow_path, "--baud", "1250000", "--timeout", "1000", "read", "ram", "0x400", "4")
+    if rc == 0 and "8B 00" in out:
+        wrong += 1
+check(rc_a == 4 and wrong == 0, f"a stale reply left by a previous run never answers the next run ({wrong} wrong of 3)")
+slow.terminate()
+slow.wait(timeout=10)
+p = subprocess.run([RCB4, "encode", "ping"], capture_output=True, text=True, env={**os.environ, "RCB4_DEVICE": ""})
+check(p.returncode == 0 and "04 FE 06 08" in p.stdout, "an empty RCB4_DEVICE does not block commands that open no device")
+expect_rc(["--device", "tcp:127.0.0.1:99999", "ping"], 2, "99999 is outside")
+expect_rc(["--device", "tcp:127.0.0.1", "ping"], 2, "expected tcp:HOST:PORT")
+expect_rc(["motion", "play", "2", "--timeout", "5"], 2, "--timeout requires --wait")
+t0 = time.monotonic()
+expect_rc(["read", "rom", "0", "0x40000", "--output", "/proc/no-such-dir/x.bin"], 3, "cannot create it")
+check(time.monotonic() - t0 < 3, "read --output into a bad path fails before the transfer")
+rc, out, err = run("--json", "--device", "tcp:" + "127.0.0.1:1", "--baud", "1250000", "config", "set", "baud=625000")
+check(rc != 0, "config set baud= over TCP does not claim the bridge followed")
+
 finish()

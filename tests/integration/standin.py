@@ -2,7 +2,7 @@
 # An RCB-4 stand-in written here in Python from protocol.md, independent of this project's code:
 # a board that is not ours, for the CLI's tests and the transport bench. As a program it serves
 # one on a pseudo-terminal, prints the path, and serves until killed:
-#   python3 tests/integration/standin.py [--servos N] [--mode nack|badsum|echo|drop]
+#   python3 tests/integration/standin.py [--mode nack|badsum|echo|drop|short|empty|late|die]
 # SPDX-License-Identifier: BSL-1.0
 import os
 import threading

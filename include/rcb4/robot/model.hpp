@@ -1,0 +1,247 @@
+// rcb4 — the robot model: joints by name in degrees, with limits, on ICS slots (std only).
+// SPDX-License-Identifier: BSL-1.0
+//
+// A joint is one servo seen as a robot user sees it: "left_knee", in degrees from the robot's
+// own zero, within limits. Its servo position follows (protocol.md §7: 7500 is the centre,
+// 4000 counts per 135°, KRS servos turn over 3500..11500):
+//
+//   servo degrees = direction × joint degrees + offset
+//   position      = 7500 + servo degrees × 4000 / 135
+//
+// Nothing here does I/O; the operations on a model are in <rcb4/robot/ops.hpp>, the profile
+// file that fills one in <rcb4/robot/profile.hpp> (a separate target).
+#pragma once
+
+#include <rcb4/ops/servos.hpp>
+#include <rcb4/values.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace rcb4::robot {
+
+/** A servo family's travel: the positions it reaches and their angle (ICS servos, §7). */
+struct servo_kind {
+  std::string_view name;       ///< "KRS"
+  std::uint16_t low = 3500;    ///< position at -half_turn
+  std::uint16_t high = 11500;  ///< position at +half_turn
+  double half_turn = 135.0;    ///< degrees from centre to either end
+};
+
+/** KONDO's KRS ICS servos (KRS-2552, -3304, -4034 …): ±135° over 3500..11500. */
+inline constexpr servo_kind krs{"KRS", 3500, 11500, 135.0};
+
+/** What went wrong, in words that name the joint, the value and the limit. */
+struct problem {
+  std::string message;  ///< e.g. "left_knee: 140 degrees is beyond its upper limit 125"
+};
+
+/** A value or a problem. */
+template <class T>
+using outcome = std::variant<T, problem>;
+
+/** True when @p o holds a value. */
+template <class T>
+bool ok(const outcome<T>& o) noexcept {
+  return o.index() == 0;
+}
+
+/** One joint: a name, its servo slot, how the servo's angle maps to the joint's, its limits. */
+struct joint {
+  std::string name;                  ///< lower case, [a-z0-9_]: "left_knee"
+  ics_number ics{};                  ///< the slot: 2 × servo ID + bus (0: SIO1-4, 1: SIO5-8)
+  int direction = 1;                 ///< +1 or -1: which way the servo turns for + joint degrees
+  double offset = 0;                 ///< servo degrees at joint 0
+  double lower = -135, upper = 135;  ///< joint limits, degrees
+  servo_kind kind = krs;             ///< the servo's travel
+
+  /** The servo ID on its bus (ICS ÷ 2). */
+  unsigned servo_id() const noexcept { return ics.value() / 2u; }
+  /** The bus: 1 for SIO1–SIO4, 2 for SIO5–SIO8 (ICS parity). */
+  unsigned bus() const noexcept { return ics.value() % 2u + 1u; }
+};
+
+/** The position that puts @p j at @p degrees; a problem beyond the joint's limits or the servo's travel. */
+inline outcome<servo_position> to_position(const joint& j, double degrees) {
+  if (!std::isfinite(degrees)) return problem{j.name + ": not a number of degrees"};
+  // A hair of tolerance: a limit typed as 30 must accept the 30.0000001 a round trip gives.
+  constexpr double eps = 1e-6;
+  if (degrees < j.lower - eps)
+    return problem{j.name + ": " + std::to_string(degrees) + " degrees is beyond its lower limit " +
+                   std::to_string(j.lower)};
+  if (degrees > j.upper + eps)
+    return problem{j.name + ": " + std::to_string(degrees) + " degrees is beyond its upper limit " +
+                   std::to_string(j.upper)};
+  const double servo_deg = j.direction * degrees + j.offset;
+  const double counts_per_degree = (j.kind.high - j.kind.low) / (2 * j.kind.half_turn);
+  const double centre = (j.kind.high + j.kind.low) / 2.0;
+  const double p = std::round(centre + servo_deg * counts_per_degree);
+  if (p < j.kind.low || p > j.kind.high)
+    return problem{j.name + ": " + std::to_string(degrees) + " degrees needs the servo at " +
+                   std::to_string(static_cast<long>(p)) + ", beyond its travel " + std::to_string(j.kind.low) + ".." +
+                   std::to_string(j.kind.high)};
+  return servo_position::make(static_cast<int>(p)).value();
+}
+
+/** The joint angle of servo position @p p; nothing for FREE, HOLD or a value outside 0..16383. */
+inline std::optional<double> to_degrees(const joint& j, std::uint16_t p) {
+  const auto v = servo_position::make(p);
+  if (!v || v->is_free() || v->is_hold()) return std::nullopt;
+  const double counts_per_degree = (j.kind.high - j.kind.low) / (2 * j.kind.half_turn);
+  const double centre = (j.kind.high + j.kind.low) / 2.0;
+  const double servo_deg = (p - centre) / counts_per_degree;
+  return (servo_deg - j.offset) / j.direction;
+}
+
+/** A named set of joints ("left_arm", "legs"). */
+struct group {
+  std::string name;                 ///< the group's name
+  std::vector<std::string> joints;  ///< its joints' names
+};
+
+/** A motion slot with a name a person gave it (a HeartToHeart4 project). */
+struct motion_name {
+  unsigned slot = 0;  ///< 1-based
+  std::string name;   ///< "walk forward"
+};
+
+/** A robot: its joints, groups and motion names, checked when made. */
+class model {
+ public:
+  model() = default;
+  /**
+   * The model of @p joints, @p groups and @p motions; a problem for a duplicate name or ICS,
+   * ICS 35 (the receiver's slot), a direction other than ±1, reversed limits, limits the servo
+   * cannot reach, a group naming an unknown joint, or a name that is also a joint's.
+   */
+  static outcome<model> make(std::string name, std::vector<joint> joints, std::vector<group> groups = {},
+                             std::vector<motion_name> motions = {});
+
+  /** The robot's name ("KHR-3HV"). */
+  const std::string& name() const noexcept { return name_; }
+  /** Every joint, in the order given. */
+  const std::vector<joint>& joints() const noexcept { return joints_; }
+  /** Every group; "all" is implicit. */
+  const std::vector<group>& groups() const noexcept { return groups_; }
+  /** Named motion slots. */
+  const std::vector<motion_name>& motions() const noexcept { return motions_; }
+  /** The joint called @p name, or nullptr. */
+  const joint* find(std::string_view name) const noexcept;
+  /** The joint on slot @p ics, or nullptr. */
+  const joint* on(ics_number ics) const noexcept;
+  /** The joints a word names: a joint, a group, or "all"; a problem for an unknown word. */
+  outcome<std::vector<const joint*>> select(std::string_view word) const;
+  /** The name of motion @p slot, or empty. */
+  std::string_view motion(unsigned slot) const noexcept;
+  /** Every joint's slot. */
+  servo_mask mask() const noexcept;
+
+ private:
+  std::string name_;
+  std::vector<joint> joints_;
+  std::vector<group> groups_;
+  std::vector<motion_name> motions_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+inline outcome<model> model::make(std::string name, std::vector<joint> joints, std::vector<group> groups,
+                                  std::vector<motion_name> motions) {
+  auto num = [](double v) {
+    std::string s = std::to_string(v);
+    while (s.size() > 1 && s.back() == '0') s.pop_back();
+    if (!s.empty() && s.back() == '.') s.pop_back();
+    return s;
+  };
+  servo_mask seen;
+  for (std::size_t i = 0; i < joints.size(); ++i) {
+    const auto& j = joints[i];
+    if (j.name.empty()) return problem{"joint " + std::to_string(i + 1) + ": no name"};
+    for (char c : j.name)
+      if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'))
+        return problem{"joint '" + j.name + "': names use a-z, 0-9 and _"};
+    if (j.name == "all") return problem{"joint 'all': the name is reserved for every joint"};
+    for (std::size_t k = 0; k < i; ++k)
+      if (joints[k].name == j.name) return problem{"joint '" + j.name + "' is given twice"};
+    if (j.ics.value() == 35) return problem{j.name + ": ICS 35 is the receiver's slot (KRR), not a servo"};
+    if (seen.contains(j.ics)) {
+      for (std::size_t k = 0; k < i; ++k)
+        if (joints[k].ics == j.ics)
+          return problem{j.name + ": ICS " + std::to_string(j.ics.value()) + " is already " + joints[k].name + "'s"};
+    }
+    seen.insert(j.ics);
+    if (j.direction != 1 && j.direction != -1) return problem{j.name + ": direction is 1 or -1"};
+    if (!(j.lower < j.upper))
+      return problem{j.name + ": limits reversed or empty (lower " + num(j.lower) + ", upper " + num(j.upper) + ")"};
+    // Both limits must be positions the servo reaches.
+    for (double limit : {j.lower, j.upper})
+      if (const double s = j.direction * limit + j.offset; std::abs(s) > j.kind.half_turn + 1e-9)
+        return problem{j.name + ": the limit " + num(limit) + " degrees puts the servo at " + num(s) +
+                       " degrees, beyond its ±" + num(j.kind.half_turn)};
+  }
+  for (const auto& g : groups) {
+    if (g.name.empty() || g.name == "all") return problem{"group '" + g.name + "': a group needs its own name"};
+    for (const auto& j : joints)
+      if (j.name == g.name) return problem{"group '" + g.name + "': a joint has that name"};
+    for (const auto& n : g.joints)
+      if (std::none_of(joints.begin(), joints.end(), [&](const joint& j) { return j.name == n; }))
+        return problem{"group '" + g.name + "': no joint is called '" + n + "'"};
+  }
+  for (const auto& m : motions)
+    if (m.slot < 1 || m.slot > 120)
+      return problem{"motion '" + m.name + "': slot " + std::to_string(m.slot) + " is outside 1..120"};
+  model out;
+  out.name_ = std::move(name);
+  out.joints_ = std::move(joints);
+  out.groups_ = std::move(groups);
+  out.motions_ = std::move(motions);
+  return out;
+}
+
+inline const joint* model::find(std::string_view n) const noexcept {
+  for (const auto& j : joints_)
+    if (j.name == n) return &j;
+  return nullptr;
+}
+
+inline const joint* model::on(ics_number ics) const noexcept {
+  for (const auto& j : joints_)
+    if (j.ics == ics) return &j;
+  return nullptr;
+}
+
+inline outcome<std::vector<const joint*>> model::select(std::string_view word) const {
+  std::vector<const joint*> out;
+  if (word == "all") {
+    for (const auto& j : joints_) out.push_back(&j);
+    return out;
+  }
+  if (const auto* j = find(word)) return std::vector<const joint*>{j};
+  for (const auto& g : groups_)
+    if (g.name == word) {
+      for (const auto& n : g.joints) out.push_back(find(n));
+      return out;
+    }
+  return problem{"no joint or group is called '" + std::string(word) + "'"};
+}
+
+inline std::string_view model::motion(unsigned slot) const noexcept {
+  for (const auto& m : motions_)
+    if (m.slot == slot) return m.name;
+  return {};
+}
+
+inline servo_mask model::mask() const noexcept {
+  servo_mask m;
+  for (const auto& j : joints_) m.insert(j.ics);
+  return m;
+}
+
+}  // namespace rcb4::robot
