@@ -243,6 +243,13 @@ void on_run(CLI::App* cmd, context& ctx, std::function<int()> f) {
   cmd->callback([&ctx, f = std::move(f)] { ctx.action = f; });
 }
 
+std::string_view plain_message(std::string_view what) {
+  if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']') what = what.substr(0, at);
+  for (std::string_view prefix : {"rcb4 operation: ", "rcb4: "})
+    if (what.substr(0, prefix.size()) == prefix) what.remove_prefix(prefix.size());
+  return what;
+}
+
 failure explain(const std::error_code& ec, std::string_view what) {
   namespace t = rcb4::transport;
   if (ec.category() == rcb4::codec_category()) {

@@ -198,6 +198,9 @@ void add_host_commands(CLI::App& app, context& ctx);    ///< list, doctor (cmd_h
 void add_frame_commands(CLI::App& app, context& ctx);   ///< decode, encode (cmd_frames.cpp)
 void add_serve_command(CLI::App& app, context& ctx);    ///< serve (cmd_serve.cpp)
 
+/** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
+std::string_view plain_message(std::string_view what);
+
 /** Exit code and hint for an error from the device or the board. */
 failure explain(const std::error_code& ec, std::string_view what);
 

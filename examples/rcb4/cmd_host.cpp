@@ -203,10 +203,7 @@ int doctor(const globals& g) {
       const auto v = s.run(rcb4::ops::read_version{});
       report(true, fmt::format("board answers at {} baud: {}", s.baud(), v));
     } catch (const std::runtime_error& e) {  // std:: or boost::system::system_error
-      std::string_view what = e.what();
-      if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']')
-        what = what.substr(0, at);
-      report(false, fmt::format("no board: {}", what),
+      report(false, fmt::format("no board: {}", plain_message(e.what())),
              "power the board (battery or supply), check the cable and that the adapter is in RCB-4 (not ICS) mode; "
              "`rcb4 --device PATH --trace ping` shows the bytes");
     }

@@ -25,12 +25,7 @@ exit codes: 0 ok, 1 the board refused or answered wrongly, 2 usage, 3 device/I/O
 
 /** Prints a failure as text on stderr, or as one JSON object on stdout; returns its exit code. */
 int fail(const cli::globals& g, std::string_view command, const cli::failure& f) {
-  std::string_view what = f.what();
-  // Boost's what() ends with the code's location " [category:value]"; the library's throwing
-  // calls prefix "rcb4 ...:". A person needs the words only.
-  if (const auto at = what.rfind(" ["); at != std::string_view::npos && what.back() == ']') what = what.substr(0, at);
-  for (std::string_view prefix : {"rcb4 operation: ", "rcb4: "})
-    if (what.substr(0, prefix.size()) == prefix) what.remove_prefix(prefix.size());
+  const std::string_view what = cli::plain_message(f.what());
   if (g.json) {
     cli::json j;
     j["error"] = what;
