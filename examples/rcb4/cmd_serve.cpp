@@ -20,7 +20,7 @@ struct serve_options {
   std::string rom_path;
   long long latency_us = 0;
   std::string series = "reboot", shift = "measured";
-  long long servos = 22;
+  long long servos = -1;
   rcb4::transport::serve_options serve;
   rcb4::board::options board;
 };
@@ -44,7 +44,7 @@ int serve(serve_options& o, const globals& g) {
   o.serve.latency = std::chrono::microseconds(o.latency_us);
   o.board.series = o.series == "execute" ? board::series_behaviour::execute : board::series_behaviour::reboot;
   o.board.shift = o.shift == "manual" ? shift_encoding::kondo_manual : shift_encoding::measured_2015;
-  o.board.servo_count = static_cast<std::uint8_t>(o.servos);
+  if (o.servos >= 0) o.board.servos = rcb4::board::first_slots(static_cast<unsigned>(o.servos));
 
   std::optional<boost::asio::ip::tcp::endpoint> endpoint;
   if (!o.tcp.empty()) {
@@ -121,7 +121,7 @@ void add_serve_command(CLI::App& app, context& ctx) {
   cmd->add_flag("--arith-to-com", o->board.allow_arith_to_com,
                 "answer arithmetic with COM as destination (refused by default)");
   cmd->add_flag("--strict-timing", o->board.strict_timing, "drop frames whose bytes arrive more than 150 us apart");
-  cmd->add_option("--servos", o->servos, "allocated servo slots ICS 0..N-1 (default 22; ICS 35 is the receiver)")
+  cmd->add_option("--servos", o->servos, "N anonymous servo slots, ICS 0..N-1, instead of the robot's (ICS 35 is the receiver)")
       ->check(int_range(0, 35));
   cmd->footer(
       "Serves an emulated RCB-4HV until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"

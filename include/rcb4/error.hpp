@@ -55,10 +55,11 @@ enum class errc : std::uint8_t {
   index_out_of_range,       ///< counter, user parameter, timer or AD index past the board's count
   motion_slot_empty,        ///< the motion's ROM slot holds no program (erased: 0xFF)
   motion_slot_not_a_frame,  ///< the slot's first bytes fail a frame's checksum: another ROM layout?
+  servo_not_allocated,      ///< a servo the operation names has no block in the ICS allocation table
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::motion_slot_not_a_frame;
+inline constexpr errc errc_last = errc::servo_not_allocated;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -104,6 +105,9 @@ constexpr const char* message(errc e) noexcept {
     case errc::motion_slot_not_a_frame:
       return "the motion slot does not start with a valid frame: the program was written for another "
              "HeartToHeart4 ROM layout (1.3, 2.0-2.1 or 2.2+)?";
+    case errc::servo_not_allocated:
+      return "a servo named has no block in the board's ICS allocation table (RAM 0x0044): the board would "
+             "ignore it";
   }
   return "unknown rcb4 error";
 }

@@ -236,6 +236,20 @@ inline constexpr rom_layout hth4_2_0{"HTH4 2.0-2.1", 0x00444, 0x0044B, 0x005DC, 
 /** HTH4 2.2 and later: what KONDO's own libraries use. */
 inline constexpr rom_layout hth4_2_2{"HTH4 2.2+", 0x00444, 0x0044B, 0x005DC, 0x00B80, 2048, 120};
 
+/**
+ * HTH4's images in ROM of what the board loads into RAM at power-on (protocol.md §8, every
+ * layout): the ICS allocation table (72 bytes, RAM 0x0044) and the servo data blocks (RAM 0x0090
+ * onwards, 20 bytes per block). A trim written at image + (block − 0x0090) + 2 survives a power cycle.
+ */
+namespace hth4_rom {
+inline constexpr rom_address allocation_image{0x005DE};  ///< image of RAM 0x0044..0x008B
+inline constexpr rom_address servo_image{0x00626};       ///< image of RAM 0x0090 onwards
+/** The ROM image address of RAM byte @p a of the servo area (a ≥ 0x0090). */
+constexpr rom_address servo_image_of(std::uint16_t a) noexcept {
+  return rom_address::make(servo_image.value() + (a - ram::user_area.value())).value();
+}
+}  // namespace hth4_rom
+
 /** ROM address of motion @p n (1-based) under @p layout. */
 constexpr result<rom_address> motion_address(const rom_layout& layout, unsigned n) noexcept {
   if (n < 1 || n > layout.motion_count) return errc::motion_out_of_range;

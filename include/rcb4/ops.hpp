@@ -10,4 +10,5 @@
 #include <rcb4/ops/planner.hpp>
 #include <rcb4/ops/sensors.hpp>
 #include <rcb4/ops/servos.hpp>
+#include <rcb4/ops/survey.hpp>
 #include <rcb4/ops/system.hpp>

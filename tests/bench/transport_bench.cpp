@@ -184,7 +184,7 @@ void control_cycle(const command& write36) {
   t::serve_options so;
   so.pace = true;
   board::options bo;
-  bo.servo_count = 35;
+  bo.servos = rcb4::board::first_slots(35);
   rcb4::testing::served_board b(so, bo), raw_board(so, bo);
   const auto cost = ops::link_cost::at(1250000, std::chrono::microseconds(25));
   t::io_thread io;

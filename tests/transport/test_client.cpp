@@ -477,7 +477,7 @@ TEST_CASE("client: operations run on the client, baud detection, bad addresses",
   CHECK(ec == std::errc::no_such_file_or_directory);
   auto c = open_client(io, b.server->where());
   const auto states = t::run(c, ops::read_servo_states{});
-  CHECK(states.size() == 22);
+  CHECK(states.size() == 20);
   auto fut = boost::asio::co_spawn(io.context(), t::async_run(c, ops::read_motion_state{}), boost::asio::use_future);
   CHECK_FALSE(fut.get().running);
   ops::read_memory bad(ops::memory::ram, 0x0480, 32);

@@ -123,7 +123,7 @@ TEST_CASE("ops: servo states through the allocation table", "[ops][servo]") {
   run(w, op);
   REQUIRE(op.error() == errc{});
   const auto& s = op.value();
-  REQUIRE(s.size() == 22);
+  REQUIRE(s.size() == 20);  // a KHR-3HV: ICS 0-9 and 12-21
   CHECK(s[3].position == 8000);
   CHECK(s[3].target == 8000);
   CHECK(s[5].trim == -10);
@@ -286,16 +286,17 @@ TEST_CASE("ops: scan, free and hold, parameters, per-servo speeds", "[ops][servo
   ops::scan_servos scan;
   run(w, scan);
   REQUIRE(scan.error() == errc{});
-  REQUIRE(scan.value().size() == 22);
+  REQUIRE(scan.value().size() == 20);  // a KHR-3HV: ICS 0-9 and 12-21
   CHECK(scan.value().front() == ops::servo_slot{ics_number{0}, 0x0090});
   CHECK(scan.value().back() == ops::servo_slot{ics_number{21}, 0x0090 + 21 * 20});
 
   auto all_free = ops::set_servo_power(ops::power_state::free);
   CHECK(run(w, all_free).size() == 2);  // the table, then one CONST frame
   REQUIRE(all_free.error() == errc{});
-  CHECK(all_free.value().size() == 22);
+  CHECK(all_free.value().size() == 20);
   w.wait(30ms);
-  for (unsigned k = 0; k < 22; ++k) CHECK(w.read_word(static_cast<std::uint16_t>(0x0090 + 20 * k + 6)) == 0x8000);
+  for (unsigned k = 0; k < 22; ++k)
+    if (k != 10 && k != 11) CHECK(w.read_word(static_cast<std::uint16_t>(0x0090 + 20 * k + 6)) == 0x8000);
 
   servo_mask three;
   three.insert(ics_number{3});

@@ -19,8 +19,12 @@
 
 namespace rcb4::board {
 
-/** The servo slots the default robot has: ICS 0–21 (IDs 0–10 on both connector sides, like a KHR-3HV). */
-inline constexpr std::uint8_t default_servo_count = 22;
+/**
+ * The servo slots of the default robot, a KHR-3HV as profiles/khr-3hv.yaml assigns it: servo IDs
+ * 0–4 and 6–10 on both connector sides, ICS 0–9 and 12–21 (ID 5, ICS 10 and 11, is unused).
+ * A unit test checks that the built-in profile and this mask agree.
+ */
+inline constexpr servo_mask khr3hv_servos = servo_mask::from_bits(0x3FF3FFu).value();
 
 /** Power-on config word of the default ROM: ICS on, ROM program on, vector jump on, 10 ms, COM 1.25 Mbaud. */
 inline constexpr std::uint16_t default_config = 0x008B;
@@ -54,7 +58,7 @@ inline constexpr std::string_view demo_motion_names[] = {"home", "wave", "bow"};
 
 /**
  * The default 256 KiB ROM image: boot, main loop, config word, and three demo motions:
- * 1 "home" (every servo to 7500), 2 "wave" (right arm), 3 "bow" (hips and knees).
+ * 1 "home" (every servo of khr3hv_servos to 7500), 2 "wave" (right arm), 3 "bow" (hips and knees).
  */
 inline std::vector<std::uint8_t> default_rom() {
   std::vector<std::uint8_t> rom(rom_size, 0xFF);  // erased EEPROM reads 0xFF
@@ -66,10 +70,9 @@ inline std::vector<std::uint8_t> default_rom() {
   rom[l.config.value()] = static_cast<std::uint8_t>(default_config & 0xFF);
   rom[l.config.value() + 1] = static_cast<std::uint8_t>(default_config >> 8);
 
-  put_motion(rom, l, 1,
-             {{30, {{0, 7500},  {1, 7500},  {2, 7500},  {3, 7500},  {4, 7500},  {5, 7500},  {6, 7500},  {7, 7500},
-                    {8, 7500},  {9, 7500},  {10, 7500}, {11, 7500}, {12, 7500}, {13, 7500}, {14, 7500}, {15, 7500},
-                    {16, 7500}, {17, 7500}, {18, 7500}, {19, 7500}, {20, 7500}, {21, 7500}}}});
+  put_motion(rom, l, 1, {{30, {{0, 7500},  {1, 7500},  {2, 7500},  {3, 7500},  {4, 7500},  {5, 7500},  {6, 7500},
+                               {7, 7500},  {8, 7500},  {9, 7500},  {12, 7500}, {13, 7500}, {14, 7500}, {15, 7500},
+                               {16, 7500}, {17, 7500}, {18, 7500}, {19, 7500}, {20, 7500}, {21, 7500}}}});
   put_motion(rom, l, 2,
              {{20, {{3, 9500}, {5, 10500}}},
               {10, {{5, 9000}}},

@@ -52,8 +52,16 @@ struct options {
   series_behaviour series = series_behaviour::reboot;    ///< §11.2
   bool strict_timing = false;                            ///< drop a partial frame after a 150 µs gap (DOC-FW "COM")
   std::uint32_t seed = 1;                                ///< AD noise
-  std::uint8_t servo_count = default_servo_count;        ///< ICS 0..servo_count−1 are allocated servos
+  servo_mask servos = khr3hv_servos;                     ///< the allocated slots (default: a KHR-3HV's)
+  servo_mask unanswered{};                               ///< allocated slots whose servo never answers (+4 stays 0)
 };
+
+/** ICS 0..@p n−1 (at most 0..34): a board with @p n anonymous servo slots. */
+constexpr servo_mask first_slots(unsigned n) noexcept {
+  servo_mask m;
+  for (unsigned k = 0; k < n && k < 35; ++k) m.insert(ics_number::make(k).value());
+  return m;
+}
 
 /** Board time: microseconds since an epoch of the caller's choosing. */
 using board_time = std::chrono::microseconds;
@@ -160,12 +168,18 @@ class virtual_board {
     put16(ram::pio_direction.value(), 0x03FF);
     for (unsigned k = 0; k < ram::timers; ++k) put16(ram::timer.value() + 2 * k, ram::timer_stopped);
     for (unsigned k = 0; k < ics_slots; ++k) {
-      const bool servo = k < opt_.servo_count && k < 35;
+      const auto n = ics_number::make(k).value();
+      const bool servo = k < 35 && opt_.servos.contains(n);
       const std::uint16_t block = static_cast<std::uint16_t>(ram::user_area.value() + servo_block::size * k);
       put16(ram::ics_allocation.value() + 2 * k, servo || k == 35 ? block : ram::no_allocation);
       if (servo) {
         ram_[block + servo_block::id.offset] = static_cast<std::uint8_t>(k / 2);
-        put16(block + servo_block::position.offset, servo_position::centre_value);
+        // The trim HTH4 keeps in ROM's servo image (protocol.md §8); erased (0xFFFF): none.
+        const std::uint32_t t = hth4_rom::servo_image_of(static_cast<std::uint16_t>(block + 2u)).value();
+        const auto trim = static_cast<std::uint16_t>(rom_[t] | (rom_[t + 1] << 8));
+        put16(block + servo_block::trim.offset, trim == 0xFFFF ? 0 : trim);
+        const bool answers = !opt_.unanswered.contains(n);
+        put16(block + servo_block::position.offset, answers ? servo_position::centre_value : 0);
         put16(block + servo_block::target.offset, servo_position::centre_value);
         put16(block + servo_block::interp_end.offset, servo_position::centre_value);
       }
@@ -202,6 +216,16 @@ class virtual_board {
     ram_[krr::buttons.value()] = b[0];
     ram_[krr::buttons.value() + 1] = b[1];
     for (unsigned i = 0; i < krr::analog_channels; ++i) ram_[krr::analog.value() + i] = analog[i] & 0x7Fu;
+  }
+  /**
+   * Turns ICS @p n by hand to @p position (a free servo's measured position follows; a held or
+   * driven one springs back on the next tick). False when the slot has no answering servo.
+   */
+  bool turn_by_hand(ics_number n, std::uint16_t position) {
+    const auto b = block_of(n);
+    if (!b || opt_.unanswered.contains(n)) return false;
+    put16(*b + servo_block::position.offset, position);
+    return true;
   }
   /** The speed (output limit) and stretch of ICS @p n, as last set by 0x12. */
   std::pair<std::uint8_t, std::uint8_t> servo_params_of(ics_number n) const noexcept {
@@ -515,6 +539,9 @@ class virtual_board {
   }
   /** The measured position follows the output (ideal servo); FREE and HOLD leave it where it is. */
   void follow(std::uint32_t b) {
+    if (!opt_.unanswered.empty())
+      for (auto n : opt_.unanswered)
+        if (block_of(n) == b) return;  // a servo that never answers: +4 stays 0
     const std::uint16_t out = ram16(b + servo_block::target.offset);
     if (out != servo_position::free_value && out != servo_position::hold_value)
       put16(b + servo_block::position.offset, out);
