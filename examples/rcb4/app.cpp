@@ -129,7 +129,9 @@ session::session(const globals& g) {
   std::string path = g.device;
   std::uint32_t baud = 115200;
   if (path.empty()) {
-    board_ = std::make_unique<rcb4::board::virtual_board>();
+    rcb4::board::options o;
+    o.servos = robot_of(g).mask();  // the virtual board is the robot --robot names
+    board_ = std::make_unique<rcb4::board::virtual_board>(o);
     board_io_ = std::make_unique<rcb4::transport::io_thread>();
     server_ = rcb4::transport::board_server::serve_pty(board_io_->context(), *board_);
     path = server_->where();
@@ -228,6 +230,19 @@ void progress::update(std::size_t done) {
   fmt::print(stderr, "\r  {}  {}/{}  {:3.0f} %", label_, done, total_,
              total_ ? 100.0 * static_cast<double>(done) / static_cast<double>(total_) : 100.0);
   std::fflush(stderr);
+}
+
+const rcb4::robot::model& robot_of(const globals& g) {
+  static std::optional<rcb4::robot::model> loaded;
+  if (!loaded) {
+    try {
+      loaded = rcb4::robot::open_profile(g.robot);
+    } catch (const rcb4::robot::profile_error& e) {
+      throw failure(exit_usage, fmt::format("--robot {}", e.what()),
+                    "profiles/khr-3hv.yaml shows the format, with comments");
+    }
+  }
+  return *loaded;
 }
 
 void on_device(CLI::App* cmd, context& ctx, std::function<int(session&)> f) {

@@ -6,6 +6,8 @@
 #include <rcb4/board/virtual_board.hpp>
 #include <rcb4/fmt.hpp>
 #include <rcb4/ops.hpp>
+#include <rcb4/robot/ops.hpp>
+#include <rcb4/robot/profile.hpp>
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/operations.hpp>
@@ -57,7 +59,11 @@ struct globals {
   bool trace = false;                      ///< print every frame with its meaning
   bool json = false;                       ///< machine-readable output
   std::string empty_device;                ///< why the device is empty when it was named so (checked on open)
+  std::string robot = "khr-3hv";           ///< --robot: a built-in profile name or a profile file
 };
+
+/** The robot --robot names (loaded once); a bad profile is a usage error naming file and line. */
+const rcb4::robot::model& robot_of(const globals& g);
 
 /** Keys in the order they were set: output reads as it is documented. */
 using json = nlohmann::ordered_json;
@@ -197,6 +203,7 @@ void add_bench_command(CLI::App& app, context& ctx);    ///< bench (cmd_bench.cp
 void add_host_commands(CLI::App& app, context& ctx);    ///< list, doctor (cmd_host.cpp)
 void add_frame_commands(CLI::App& app, context& ctx);   ///< decode, encode (cmd_frames.cpp)
 void add_serve_command(CLI::App& app, context& ctx);    ///< serve (cmd_serve.cpp)
+void add_robot_commands(CLI::App& app, context& ctx);   ///< joint, pose, trim, scan (cmd_robot.cpp)
 
 /** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
 std::string_view plain_message(std::string_view what);

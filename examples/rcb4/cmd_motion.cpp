@@ -1,4 +1,4 @@
-// rcb4 command-line tool: motion play|stop|resume|status|wait (the ROM program's motions, §8).
+// rcb4 command-line tool: motion play|stop|resume|status|wait|list (the ROM program's motions, §8).
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
@@ -163,6 +163,42 @@ void add_motion_commands(CLI::App& app, context& ctx) {
       emit(state_json(st));
     else
       fmt::print("{}\n", state_text(st));
+    return exit_ok;
+  });
+
+  auto* list = motion->add_subcommand("list", "the used motion slots in ROM: number, name (from --robot), size");
+  auto lo = std::make_shared<motion_options>();
+  add_layout(list, *lo);
+  on_device(list, ctx, [&ctx, lo](session& s) {
+    const auto& layout = layout_of(*lo);
+    const auto& m = robot_of(ctx.g);
+    rcb4::ops::list_motions op(layout);
+    progress bar("reading motion slots", layout.motion_count, ctx.g.json);
+    rcb4::transport::error_code ec;
+    s.run_steps(op, ec, [&] { bar.update(op.slots_done()); });
+    bar.finish();
+    if (ec) throw rcb4::transport::system_error(ec, "motion list");
+    json arr = json::array();
+    if (!ctx.g.json) fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {}\n", "slot", "name", "address", "bytes", "frames");
+    for (const auto& v : op.value()) {
+      const auto name = m.motion(v.number);
+      const std::string note = !v.readable ? "not a frame: another --layout?" : v.ends ? "" : "no RETURN found";
+      if (ctx.g.json)
+        arr.push_back({{"slot", v.number},
+                       {"name", name.empty() ? json(nullptr) : json(std::string(name))},
+                       {"address", v.address},
+                       {"size", v.size},
+                       {"frames", v.frames},
+                       {"ends", v.ends},
+                       {"readable", v.readable}});
+      else
+        fmt::print("{:>4}  {:<20} 0x{:05X}  {:>6}  {:>6}  {}\n", v.number, name.empty() ? "-" : name, v.address, v.size,
+                   v.frames, note);
+    }
+    if (ctx.g.json)
+      emit(json{{"layout", layout.name}, {"motions", arr}});
+    else
+      fmt::print("{} of {} slots used ({} layout)\n", op.value().size(), layout.motion_count, layout.name);
     return exit_ok;
   });
 

@@ -44,7 +44,8 @@ int serve(serve_options& o, const globals& g) {
   o.serve.latency = std::chrono::microseconds(o.latency_us);
   o.board.series = o.series == "execute" ? board::series_behaviour::execute : board::series_behaviour::reboot;
   o.board.shift = o.shift == "manual" ? shift_encoding::kondo_manual : shift_encoding::measured_2015;
-  if (o.servos >= 0) o.board.servos = rcb4::board::first_slots(static_cast<unsigned>(o.servos));
+  // The robot --robot names (default: a KHR-3HV), unless --servos asks for anonymous slots.
+  o.board.servos = o.servos >= 0 ? rcb4::board::first_slots(static_cast<unsigned>(o.servos)) : robot_of(g).mask();
 
   std::optional<boost::asio::ip::tcp::endpoint> endpoint;
   if (!o.tcp.empty()) {
@@ -121,10 +122,12 @@ void add_serve_command(CLI::App& app, context& ctx) {
   cmd->add_flag("--arith-to-com", o->board.allow_arith_to_com,
                 "answer arithmetic with COM as destination (refused by default)");
   cmd->add_flag("--strict-timing", o->board.strict_timing, "drop frames whose bytes arrive more than 150 us apart");
-  cmd->add_option("--servos", o->servos, "N anonymous servo slots, ICS 0..N-1, instead of the robot's (ICS 35 is the receiver)")
+  cmd->add_option("--servos", o->servos,
+                  "N anonymous servo slots, ICS 0..N-1, instead of the robot's (ICS 35 is the receiver)")
       ->check(int_range(0, 35));
   cmd->footer(
-      "Serves an emulated RCB-4HV until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"
+      "Serves an emulated RCB-4HV wired as the robot --robot names (default: a KHR-3HV, 20 servos,\n"
+      "three demo motions) until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"
       "the /dev/pts/N path for --pty (open it with the usual serial settings), or HOST:PORT for --tcp\n"
       "(port 0 picks a free one; loopback unless you name another address).");
   cmd->callback([&ctx, o] {

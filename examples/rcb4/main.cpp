@@ -74,7 +74,7 @@ bool json_requested(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     const std::string_view a = argv[i];
     if (a == "--json") return true;
-    if (a == "--device" || a == "--baud" || a == "--timeout")
+    if (a == "--device" || a == "--baud" || a == "--timeout" || a == "--robot")
       ++i;
     else if (a.empty() || a[0] != '-')
       return false;  // the command: what follows is its own
@@ -111,6 +111,9 @@ int main(int argc, char** argv) {
       ->check(cli::int_range(1, 600000));
   app.add_flag("--trace", ctx.g.trace, "print every frame on stderr: time, hex, meaning");
   app.add_flag("--json", ctx.g.json, "machine-readable output: one JSON object (per line for monitor)");
+  app.add_option("--robot", ctx.g.robot,
+                 "the robot: a profile file (YAML, see profiles/) or a built-in name: khr-3hv (default), kxr-l2")
+      ->type_name("FILE");
 
   cli::add_board_commands(app, ctx);
   cli::add_memory_commands(app, ctx);
@@ -121,6 +124,7 @@ int main(int argc, char** argv) {
   cli::add_host_commands(app, ctx);
   cli::add_frame_commands(app, ctx);
   cli::add_serve_command(app, ctx);
+  cli::add_robot_commands(app, ctx);
   app.footer(std::string(footer));  // after the commands: they would inherit it
 
   ctx.g.json = json_requested(argc, argv);
@@ -155,7 +159,7 @@ int main(int argc, char** argv) {
         }
         // CLI11 names the arguments it did not expect in its message.
         const std::string_view said = e.what();
-        for (std::string_view global : {"--device", "--baud", "--timeout", "--trace", "--json"})
+        for (std::string_view global : {"--device", "--baud", "--timeout", "--trace", "--json", "--robot"})
           if (const auto at = said.find(global); at != std::string_view::npos && !words.empty() &&
                                                  (at + global.size() == said.size() || said[at + global.size()] == ' '))
             hint =

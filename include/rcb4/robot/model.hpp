@@ -68,23 +68,30 @@ struct joint {
   unsigned bus() const noexcept { return ics.value() % 2u + 1u; }
 };
 
+/** @p v as a person writes it: "90", "-12.5", "0.25" (no trailing zeros). */
+inline std::string number_text(double v) {
+  std::string s = std::to_string(std::round(v * 1e4) / 1e4);
+  while (s.size() > 1 && s.back() == '0') s.pop_back();
+  if (!s.empty() && s.back() == '.') s.pop_back();
+  if (s == "-0") s = "0";
+  return s;
+}
+
 /** The position that puts @p j at @p degrees; a problem beyond the joint's limits or the servo's travel. */
 inline outcome<servo_position> to_position(const joint& j, double degrees) {
   if (!std::isfinite(degrees)) return problem{j.name + ": not a number of degrees"};
   // A hair of tolerance: a limit typed as 30 must accept the 30.0000001 a round trip gives.
   constexpr double eps = 1e-6;
   if (degrees < j.lower - eps)
-    return problem{j.name + ": " + std::to_string(degrees) + " degrees is beyond its lower limit " +
-                   std::to_string(j.lower)};
+    return problem{j.name + ": " + number_text(degrees) + " degrees is beyond its lower limit " + number_text(j.lower)};
   if (degrees > j.upper + eps)
-    return problem{j.name + ": " + std::to_string(degrees) + " degrees is beyond its upper limit " +
-                   std::to_string(j.upper)};
+    return problem{j.name + ": " + number_text(degrees) + " degrees is beyond its upper limit " + number_text(j.upper)};
   const double servo_deg = j.direction * degrees + j.offset;
   const double counts_per_degree = (j.kind.high - j.kind.low) / (2 * j.kind.half_turn);
   const double centre = (j.kind.high + j.kind.low) / 2.0;
   const double p = std::round(centre + servo_deg * counts_per_degree);
   if (p < j.kind.low || p > j.kind.high)
-    return problem{j.name + ": " + std::to_string(degrees) + " degrees needs the servo at " +
+    return problem{j.name + ": " + number_text(degrees) + " degrees needs the servo at " +
                    std::to_string(static_cast<long>(p)) + ", beyond its travel " + std::to_string(j.kind.low) + ".." +
                    std::to_string(j.kind.high)};
   return servo_position::make(static_cast<int>(p)).value();
@@ -154,12 +161,7 @@ class model {
 
 inline outcome<model> model::make(std::string name, std::vector<joint> joints, std::vector<group> groups,
                                   std::vector<motion_name> motions) {
-  auto num = [](double v) {
-    std::string s = std::to_string(v);
-    while (s.size() > 1 && s.back() == '0') s.pop_back();
-    if (!s.empty() && s.back() == '.') s.pop_back();
-    return s;
-  };
+  const auto num = number_text;
   servo_mask seen;
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto& j = joints[i];

@@ -328,7 +328,7 @@ struct joint_trim {
 inline outcome<joint_trim> trim_of(const joint& j, double degrees) {
   if (!std::isfinite(degrees) || std::abs(degrees) > 30.0)
     return problem{j.name + ": a trim corrects a servo horn's mounting, within ±30 degrees, not " +
-                   std::to_string(degrees)};
+                   number_text(degrees)};
   const double cpd = (j.kind.high - j.kind.low) / (2 * j.kind.half_turn);
   return joint_trim{&j, static_cast<std::int16_t>(std::lround(j.direction * degrees * cpd))};
 }

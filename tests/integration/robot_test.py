@@ -1,0 +1,156 @@
+#!/usr/bin/env python3
+# The robot layer through the rcb4 tool, as a robot owner uses it: `rcb4 serve --pty` (a virtual
+# KHR-3HV) in one process, joint/pose/trim/scan/motion commands from others, checked through
+# their exit codes, their JSON and the board's own answers. Expected angles are worked out by hand.
+# SPDX-License-Identifier: BSL-1.0
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+RCB4 = sys.argv[1]
+PROFILES = sys.argv[2]
+from checks import check, finish
+
+
+def run(*args, stdin=None, timeout=60):
+    p = subprocess.run([RCB4, *args], input=stdin, capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+on = ["--device", dev]
+
+
+def joints():
+    rc, out, err = run("--json", *on, "joint", "list")
+    assert rc == 0, err
+    return {j["name"]: j for j in json.loads(out)}
+
+
+try:
+    js = joints()
+    check(len(js) >= 17 and all(j["allocated"] for j in js.values()),
+          f"--json joint list on serve --pty: {len(js)} joints, every one on an allocated slot")
+    check(js["left_knee"]["ics"] == 16 and js["left_knee"]["id"] == 8 and js["left_knee"]["bus"] == 1,
+          "left_knee is ICS 16 = servo ID 8 on SIO1-4")
+
+    with tempfile.TemporaryDirectory() as tmp:
+        rc, out, err = run(*on, "joint", "move", "left_knee=35", "head_yaw=-12.5", "--time", "200", "--wait")
+        check(rc == 0 and "left_knee to +35.0 deg" in out, f"joint move --wait ({rc}, {err.strip()!r})")
+        pose = os.path.join(tmp, "crouch.json")
+        rc, out, err = run(*on, "pose", "capture", pose)
+        check(rc == 0 and "captured 20 joints" in out, f"pose capture ({rc}, {err.strip()!r})")
+        saved = json.load(open(pose))["joints"]
+        check(abs(saved["left_knee"] - 35) < 0.05 and abs(saved["head_yaw"] + 12.5) < 0.05,
+              f"the captured file holds the angles ({saved.get('left_knee')}, {saved.get('head_yaw')})")
+        rc, out, err = run(*on, "joint", "move", "left_knee=15", "--time", "100", "--wait")
+        check(rc == 0 and abs(joints()["left_knee"]["degrees"] - 15) < 0.1, "the joint moved 20 degrees away")
+        rc, out, err = run(*on, "pose", "play", pose, "--time", "300", "--wait")
+        knee = joints()["left_knee"]["degrees"]
+        check(rc == 0 and abs(knee - 35) <= 1.0, f"pose play brings the joint back within 1 degree ({knee})")
+
+        # YAML poses, and pose show without a device.
+        yml = os.path.join(tmp, "p.yaml")
+        rc, out, err = run(*on, "pose", "capture", yml, "--joints", "legs")
+        check(rc == 0 and "captured 10 joints" in out, "pose capture --joints legs into YAML")
+        rc, out, err = run("pose", "show", yml)
+        check(rc == 0 and "left_knee" in out and "head_yaw" not in out, "pose show reads it back")
+        bad = os.path.join(tmp, "bad.json")
+        open(bad, "w").write('{"joints": {"left_knee": 131}}')
+        rc, out, err = run("pose", "show", bad)
+        check(rc == 2 and "beyond its upper limit 130" in err, f"pose show: an angle beyond a limit is exit 2 ({err.strip()!r})")
+        rc, out, err = run(*on, "pose", "play", bad)
+        check(rc == 2 and "left_knee: 131 degrees is beyond its upper limit 130" in err, "pose play of it: exit 2")
+        open(bad, "w").write('{"joints": {"tail": 1}}')
+        rc, out, err = run(*on, "pose", "play", bad)
+        check(rc == 2 and "bad.json:1:13: no joint of KHR-3HV is called 'tail'" in err, f"unknown joint in a pose: file:line ({err.strip()!r})")
+        rc, out, err = run(*on, "pose", "capture", os.path.join(tmp, "p.txt"))
+        check(rc == 2 and ".json, .yaml or .yml" in err, "pose capture into a .txt: exit 2")
+
+    before = joints()["right_knee"]["degrees"]
+    rc, out, err = run(*on, "joint", "move", "right_knee=140")
+    check(rc == 2 and "right_knee: 140 degrees is beyond its upper limit 130" in err, f"move beyond a limit: exit 2 ({err.strip()!r})")
+    check(joints()["right_knee"]["degrees"] == before, "and nothing moved")
+    rc, out, err = run(*on, "joint", "move", "right_knee=10", "head_yaw=91")
+    check(rc == 2 and joints()["right_knee"]["degrees"] == before, "one bad angle among good ones: nothing moves")
+    rc, out, err = run(*on, "joint", "move", "tail=3")
+    check(rc == 2 and "no joint is called 'tail'" in err, "an unknown joint: exit 2")
+    rc, out, err = run(*on, "joint", "move", "head_yaw=3", "--time", "3000")
+    check(rc == 2 and "2550 ms at this board's 10 ms period" in err, f"a move longer than 255 frames: exit 2 ({err.strip()!r})")
+
+    rc, out, err = run("--json", *on, "joint", "free", "left_arm")
+    check(rc == 0 and json.loads(out)["freed"] == ["left_shoulder_pitch", "left_shoulder_roll", "left_elbow_yaw", "left_elbow_pitch"],
+          "joint free left_arm frees the group's four joints")
+    js = joints()
+    check(js["left_elbow_pitch"]["state"] == "free" and js["right_elbow_pitch"]["state"] != "free", "only that group is free")
+    rc, out, err = run(*on, "joint", "hold", "all")
+    check(rc == 0 and joints()["left_elbow_pitch"]["state"] == "hold", "joint hold all")
+    rc, out, err = run(*on, "joint", "free", "tail")
+    check(rc == 2 and "no joint or group is called 'tail'" in err, "free of an unknown group: exit 2")
+
+    rc, out, err = run(*on, "trim", "set", "left_knee=1.5", "--persist")
+    check(rc == 0 and "+44 counts" in out, f"trim set --persist ({out.strip()!r})")
+    rc, out, err = run("--json", *on, "trim", "get", "left_knee")
+    t = json.loads(out)[0] if rc == 0 else {}
+    check(t.get("counts") == 44 and abs(t.get("degrees", 0) - 1.49) < 0.01, f"trim get reads it back ({t})")
+    rc, out, err = run(*on, "read", "rom", "0x768", "2")
+    check(rc == 0 and "2C 00" in out, f"--persist wrote HTH4's servo image in ROM ({out.strip()!r})")
+    rc, out, err = run(*on, "trim", "set", "left_knee=45")
+    check(rc == 2 and "within ±30 degrees" in err, "a trim beyond 30 degrees: exit 2")
+
+    rc, out, err = run("--json", *on, "motion", "list")
+    ms = json.loads(out)["motions"] if rc == 0 else []
+    check([(m["slot"], m["name"]) for m in ms] == [(1, "home"), (2, "wave"), (3, "bow")] and ms[0]["size"] == 52,
+          f"motion list shows the virtual board's motions with names and sizes ({ms})")
+    rc, out, err = run("--json", *on, "scan")
+    sc = json.loads(out) if rc == 0 else {}
+    check(len(sc.get("slots", [])) == 20 and all(s["answers"] for s in sc["slots"]) and sc["unallocated_joints"] == [],
+          "scan: 20 slots, each answering, each a joint")
+finally:
+    srv.terminate()
+    srv.wait(timeout=10)
+
+# A board with silent servos and slots the robot does not have.
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--servos", "4"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+try:
+    rc, out, err = run("--device", dev, "scan")
+    check(rc == 0 and "4 slots allocated" in out and "16 joints of KHR-3HV without a slot" in out,
+          f"scan on a 4-slot board names the joints without a slot ({out.strip().splitlines()[-1]!r})")
+    rc, out, err = run("--device", dev, "joint", "move", "left_knee=10")
+    check(rc == 1 and "no servo allocated for left_knee (ICS 16)" in err, f"moving a joint the board lacks: exit 1 ({err.strip()!r})")
+    rc, out, err = run("--json", "--device", dev, "joint", "list")
+    js = {j["name"]: j for j in json.loads(out)} if rc == 0 else {}
+    check(rc == 0 and js["head_yaw"]["allocated"] and not js["left_knee"]["allocated"] and js["left_knee"]["degrees"] is None,
+          "joint list marks the joints without a slot, with no made-up angle")
+finally:
+    srv.terminate()
+    srv.wait(timeout=10)
+
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--servos", "0"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+try:
+    rc, out, err = run("--device", dev, "joint", "list")
+    check(rc == 1 and "allocates none of KHR-3HV's joints" in err, f"an empty allocation table: exit 1 ({err.strip()!r})")
+finally:
+    srv.terminate()
+    srv.wait(timeout=10)
+
+# Profiles: the shipped files, another robot, bad files.
+rc, out, err = run("--robot", os.path.join(PROFILES, "kxr-l2.yaml"), "joint", "list")
+check(rc == 0 and "KXR-L2 (17 joints)" in out, "--robot profiles/kxr-l2.yaml (on the in-process board it describes)")
+with tempfile.TemporaryDirectory() as tmp:
+    bad = os.path.join(tmp, "r.yaml")
+    open(bad, "w").write("robot: r\njoints:\n  a: {ics: 1, lower: -10, upper: 10}\n  b: {ics: 1, lower: -10, upper: 10}\n")
+    rc, out, err = run("--robot", bad, "joint", "list")
+    check(rc == 2 and f"{bad}:4:3: b: ICS 1 is already a's" in err, f"a profile with a duplicate ICS: exit 2 with file:line ({err.strip()!r})")
+    open(bad, "w").write("robot: r\njoints:\n  a: {ics: 1, lower: -10, upper: 10, speed: 1}\n")
+    rc, out, err = run("--json", "--robot", bad, "joint", "list")
+    check(rc == 2 and "unknown key 'speed'" in json.loads(out)["error"], "an unknown key, as JSON")
+rc, out, err = run("--robot", "khr3", "joint", "list")
+check(rc == 2 and "not a built-in profile (khr-3hv, kxr-l2)" in err, "an unknown --robot: exit 2 naming the built-ins")
+
+finish()
