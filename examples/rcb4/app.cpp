@@ -18,7 +18,8 @@
 namespace cli {
 
 void emit(const json& j) {
-  fmt::print("{}\n", j.dump());
+  // Names from a profile file may be any bytes: invalid UTF-8 becomes U+FFFD, never an exception.
+  fmt::print("{}\n", j.dump(-1, ' ', false, json::error_handler_t::replace));
   std::fflush(stdout);
 }
 

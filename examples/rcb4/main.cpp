@@ -17,7 +17,8 @@ namespace {
 
 constexpr std::string_view footer = R"(
 Without --device (and without $RCB4_DEVICE) every device command talks to an in-process virtual
-RCB-4, so all of them work without a robot. `rcb4 COMMAND --help` explains each command.
+RCB-4 wired as the --robot (a KHR-3HV by default), so all of them work without a robot.
+`rcb4 COMMAND --help` explains each command; `rcb4 joint list` shows the robot's joints.
 
 exit codes: 0 ok, 1 the board refused or answered wrongly, 2 usage, 3 device/I/O problem,
             4 no answer before the deadline (with --json, failures are {"error", "exit", "hint"})

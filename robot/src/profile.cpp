@@ -51,7 +51,7 @@ long integer(const std::string& source, const YAML::Node& n, const std::string& 
 YAML::Node parse_yaml(std::string_view text, const std::string& source) {
   try {
     return YAML::Load(std::string(text));
-  } catch (const YAML::ParserException& e) {
+  } catch (const YAML::Exception& e) {  // syntax errors, and yaml-cpp's own limits (nesting depth)
     throw profile_error(where(source, e.mark), e.msg);
   }
 }
@@ -106,7 +106,26 @@ joint parse_joint(const std::string& source, const std::string& name, const YAML
 
 }  // namespace
 
+model parse_profile_nodes(std::string_view text, const std::string& source);
+pose parse_pose_nodes(std::string_view text, const std::string& source, const model& m);
+
 model parse_profile(std::string_view text, const std::string& source) {
+  try {
+    return parse_profile_nodes(text, source);
+  } catch (const YAML::Exception& e) {
+    throw profile_error(where(source, e.mark), e.msg);
+  }
+}
+
+pose parse_pose(std::string_view text, const std::string& source, const model& m) {
+  try {
+    return parse_pose_nodes(text, source, m);
+  } catch (const YAML::Exception& e) {
+    throw profile_error(where(source, e.mark), e.msg);
+  }
+}
+
+model parse_profile_nodes(std::string_view text, const std::string& source) {
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw profile_error(source, "a profile is a mapping with robot, joints, groups, motions");
   check_keys(source, root, {"robot", "joints", "groups", "motions"}, "profile");
@@ -177,7 +196,7 @@ model open_profile(std::string_view what) {
   return load_profile(std::filesystem::path(what));
 }
 
-pose parse_pose(std::string_view text, const std::string& source, const model& m) {
+pose parse_pose_nodes(std::string_view text, const std::string& source, const model& m) {
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw profile_error(source, "a pose is a mapping with robot, joints and optionally time_ms");
   check_keys(source, root, {"robot", "joints", "time_ms"}, "pose");
@@ -209,7 +228,8 @@ std::string pose_json(const pose& p) {
   nlohmann::ordered_json joints = nlohmann::ordered_json::object();
   for (const auto& [n, d] : p.joints) joints[n] = std::round(d * 100) / 100;
   j["joints"] = joints;
-  return j.dump(2) + "\n";
+  // A robot name read from a file may be any bytes: invalid UTF-8 becomes U+FFFD (found by fuzzing).
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 std::string pose_yaml(const pose& p) {
