@@ -139,6 +139,15 @@ std::vector<robot::joint_target> targets_of(const std::vector<std::string>& item
   return out;
 }
 
+/** The pose file @p path for @p m; a bad one is a usage error with its file:line. */
+robot::pose pose_of(const std::string& path, const robot::model& m) {
+  try {
+    return robot::load_pose(path, m);
+  } catch (const robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+}
+
 void print_joints(const robot::model& m, const std::vector<robot::joint_reading>& rs, const globals& g) {
   if (g.json) {
     json list = json::array();
@@ -332,12 +341,7 @@ void add_pose(CLI::App& app, context& ctx) {
   play->callback([&ctx, po] {
     ctx.action = [&ctx, po] {
       const auto& m = robot_of(ctx.g);
-      robot::pose p;
-      try {
-        p = robot::load_pose(po->file, m);
-      } catch (const robot::profile_error& e) {
-        throw usage_error(e.what());
-      }
+      const auto p = pose_of(po->file, m);
       std::vector<robot::joint_target> t;
       for (const auto& [n, d] : p.joints) t.push_back({n, d, std::nullopt});
       const auto time = po->time_ms >= 0 ? std::chrono::milliseconds(po->time_ms) : p.time.value_or(1000ms);
@@ -353,12 +357,7 @@ void add_pose(CLI::App& app, context& ctx) {
   show->add_option("FILE", *file, "pose file (.json, .yaml or .yml)")->required();
   on_run(show, ctx, [&ctx, file] {
     const auto& m = robot_of(ctx.g);
-    robot::pose p;
-    try {
-      p = robot::load_pose(*file, m);
-    } catch (const robot::profile_error& e) {
-      throw usage_error(e.what());
-    }
+    const auto p = pose_of(*file, m);
     std::vector<std::string> problems;
     json list = json::array();
     for (const auto& [n, d] : p.joints) {

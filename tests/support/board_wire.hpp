@@ -67,4 +67,15 @@ class board_wire {
   std::chrono::microseconds now_{0};
 };
 
+/** Runs the sans-I/O operation @p op on @p w's board; returns the commands it sent. */
+template <class Op>
+std::vector<command> run(board_wire& w, Op& op) {
+  std::vector<command> sent;
+  while (auto c = op.next()) {
+    sent.push_back(*c);
+    op.on_reply(w.send(*c));
+  }
+  return sent;
+}
+
 }  // namespace rcb4::testing

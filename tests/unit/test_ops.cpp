@@ -13,16 +13,7 @@ using namespace std::chrono_literals;
 using rcb4::testing::board_wire;
 
 namespace {
-/** Runs @p op on the board; returns the commands it sent. */
-template <class Op>
-std::vector<command> run(board_wire& w, Op& op) {
-  std::vector<command> sent;
-  while (auto c = op.next()) {
-    sent.push_back(*c);
-    op.on_reply(w.send(*c));
-  }
-  return sent;
-}
+using rcb4::testing::run;
 std::size_t read_size(const command& c) { return std::get<move>(c).src().size(); }
 }  // namespace
 

@@ -13,17 +13,9 @@ using namespace rcb4;
 using namespace rcb4::robot;
 using namespace std::chrono_literals;
 using rcb4::testing::board_wire;
+using rcb4::testing::run;
 
 namespace {
-template <class Op>
-std::vector<command> run(board_wire& w, Op& op) {
-  std::vector<command> sent;
-  while (auto c = op.next()) {
-    sent.push_back(*c);
-    op.on_reply(w.send(*c));
-  }
-  return sent;
-}
 joint make_joint(std::string name, unsigned ics, int direction = 1, double offset = 0) {
   joint j;
   j.name = std::move(name);

@@ -58,6 +58,46 @@ inline std::vector<servo_slot> allocated_slots(const reply& r) {
   }
   return slots;
 }
+
+/**
+ * RAM reads of byte ranges, as plan_reads chooses them for a link, into a RAM image: the read
+ * half of every servo-block reader (read_servo_states, scan_slots, robot::read_joints).
+ * restart() runs the same plan again without allocating.
+ */
+class planned_reads {
+ public:
+  planned_reads() = default;
+  /** Plans the reads of @p wanted for @p cost. */
+  planned_reads(std::vector<byte_range> wanted, link_cost cost)
+      : plan_(plan_reads(std::move(wanted), cost)), memory_(ram_size, 0) {}
+  /** The next read, or nothing when every read is done. */
+  std::optional<command> next() const {
+    if (done()) return std::nullopt;
+    return command{
+        move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
+            .value()};
+  }
+  /** Takes the reply to next()'s read: errc{} and its bytes stored, or what was wrong with it. */
+  errc on_reply(const reply& r) {
+    if (const auto e = check_reply(r, true, plan_[step_].size); e != errc{}) return e;
+    std::copy(r.bytes().begin(), r.bytes().end(), memory_.begin() + plan_[step_].address);
+    ++step_;
+    return errc{};
+  }
+  /** True when every read has its reply. */
+  bool done() const noexcept { return step_ >= plan_.size(); }
+  /** The 16-bit little-endian word read at RAM @p a. */
+  std::uint16_t word(std::uint32_t a) const { return static_cast<std::uint16_t>(memory_[a] | (memory_[a + 1] << 8)); }
+  /** The reads chosen. */
+  const std::vector<byte_range>& plan() const noexcept { return plan_; }
+  /** Starts the same reads again. */
+  void restart() noexcept { step_ = 0; }
+
+ private:
+  std::vector<byte_range> plan_;
+  std::vector<std::uint8_t> memory_;
+  std::size_t step_ = 0;
+};
 }  // namespace detail
 
 /** Scans the allocation table: the ICS slots that have a servo block, ascending. */
@@ -99,13 +139,10 @@ class read_servo_states {
   /** Plans its reads for @p cost (the link's byte time and per-exchange overhead). */
   explicit read_servo_states(link_cost cost = {}) : cost_(cost) {}
   /** The next read. */
-  std::optional<command> next() {
+  std::optional<command> next() const {
     if (error_ != errc{}) return std::nullopt;
     if (!table_read_) return detail::read_allocation();
-    if (step_ >= plan_.size()) return std::nullopt;
-    return command{
-        move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
-            .value()};
+    return reads_.next();
   }
   /** Takes a reply. */
   void on_reply(const reply& r) {
@@ -114,35 +151,29 @@ class read_servo_states {
       std::vector<byte_range> wanted;
       blocks_ = detail::allocated_slots(r);
       for (const auto& b : blocks_) wanted.push_back({b.address + 2u, 6u});  // trim, position, target
-      plan_ = plan_reads(wanted, cost_);
-      memory_.assign(ram_size, 0);
+      reads_ = detail::planned_reads(std::move(wanted), cost_);
       table_read_ = true;
       return;
     }
-    if ((error_ = detail::check_reply(r, true, plan_[step_].size)) != errc{}) return;
-    std::copy(r.bytes().begin(), r.bytes().end(), memory_.begin() + plan_[step_].address);
-    if (++step_ == plan_.size()) decode();
+    if ((error_ = reads_.on_reply(r)) == errc{} && reads_.done()) decode();
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
   /** One state per allocated servo slot, ascending. */
   const std::vector<servo_state>& value() const noexcept { return states_; }
   /** The reads chosen after the table (for inspection and benchmarks). */
-  const std::vector<byte_range>& plan() const noexcept { return plan_; }
+  const std::vector<byte_range>& plan() const noexcept { return reads_.plan(); }
 
  private:
-  std::uint16_t word(std::uint32_t a) const { return static_cast<std::uint16_t>(memory_[a] | (memory_[a + 1] << 8)); }
   void decode() {
     for (const auto& b : blocks_)
-      states_.push_back(
-          {b.ics, static_cast<std::int16_t>(word(b.address + 2u)), word(b.address + 4u), word(b.address + 6u)});
+      states_.push_back({b.ics, static_cast<std::int16_t>(reads_.word(b.address + 2u)), reads_.word(b.address + 4u),
+                         reads_.word(b.address + 6u)});
   }
   link_cost cost_;
   bool table_read_ = false;
   std::vector<servo_slot> blocks_;
-  std::vector<byte_range> plan_;
-  std::size_t step_ = 0;
-  std::vector<std::uint8_t> memory_;
+  detail::planned_reads reads_;
   std::vector<servo_state> states_;
   errc error_{};
 };

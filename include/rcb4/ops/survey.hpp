@@ -35,10 +35,7 @@ class scan_slots {
   std::optional<command> next() const {
     if (error_ != errc{}) return std::nullopt;
     if (!table_read_) return detail::read_allocation();
-    if (step_ >= plan_.size()) return std::nullopt;
-    return command{
-        move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
-            .value()};
+    return reads_.next();
   }
   /** Takes a reply. */
   void on_reply(const reply& r) {
@@ -49,16 +46,12 @@ class scan_slots {
         probes_.push_back({s.ics, s.address, 0});
         wanted.push_back({s.address + 4u, 2u});
       }
-      plan_ = plan_reads(wanted, cost_);
-      memory_.assign(ram_size, 0);
+      reads_ = detail::planned_reads(std::move(wanted), cost_);
       table_read_ = true;
       return;
     }
-    if ((error_ = detail::check_reply(r, true, plan_[step_].size)) != errc{}) return;
-    std::copy(r.bytes().begin(), r.bytes().end(), memory_.begin() + plan_[step_].address);
-    if (++step_ == plan_.size())
-      for (auto& p : probes_)
-        p.position = static_cast<std::uint16_t>(memory_[p.address + 4u] | (memory_[p.address + 5u] << 8));
+    if ((error_ = reads_.on_reply(r)) == errc{} && reads_.done())
+      for (auto& p : probes_) p.position = reads_.word(p.address + 4u);
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
@@ -69,9 +62,7 @@ class scan_slots {
   link_cost cost_;
   bool table_read_ = false;
   std::vector<slot_probe> probes_;
-  std::vector<byte_range> plan_;
-  std::vector<std::uint8_t> memory_;
-  std::size_t step_ = 0;
+  detail::planned_reads reads_;
   errc error_{};
 };
 

@@ -131,53 +131,45 @@ class read_joints {
         wanted.push_back(what == fields::state ? ops::byte_range{*e.block + 2u, 6u}
                                                : ops::byte_range{*e.block + 4u, 2u});
     }
-    plan_ = ops::plan_reads(wanted, cost);
-    memory_.assign(ram_size, 0);
+    reads_ = ops::detail::planned_reads(std::move(wanted), cost);
   }
   /** The next read. */
   std::optional<command> next() const {
-    if (error_ != errc{} || step_ >= plan_.size()) return std::nullopt;
-    return command{
-        move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
-            .value()};
+    if (error_ != errc{}) return std::nullopt;
+    return reads_.next();
   }
   /** Takes a reply. */
   void on_reply(const reply& r) {
-    if ((error_ = ops::detail::check_reply(r, true, plan_[step_].size)) != errc{}) return;
-    std::copy(r.bytes().begin(), r.bytes().end(), memory_.begin() + plan_[step_].address);
-    if (++step_ == plan_.size()) decode();
+    if ((error_ = reads_.on_reply(r)) == errc{} && reads_.done()) decode();
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
   /** One reading per joint, in the model's order (valid once finished). */
   const std::vector<joint_reading>& value() const noexcept { return readings_; }
   /** The reads chosen. */
-  const std::vector<ops::byte_range>& plan() const noexcept { return plan_; }
+  const std::vector<ops::byte_range>& plan() const noexcept { return reads_.plan(); }
   /** Starts the same reads again (the next control-loop cycle). */
   void restart() noexcept {
-    step_ = 0;
+    reads_.restart();
     error_ = errc{};
   }
 
  private:
-  std::uint16_t word(std::uint32_t a) const { return static_cast<std::uint16_t>(memory_[a] | (memory_[a + 1] << 8)); }
   void decode() {
     for (std::size_t i = 0; i < readings_.size(); ++i) {
       auto& r = readings_[i];
       if (!r.allocated) continue;
-      r.position = word(blocks_[i] + 4u);
+      r.position = reads_.word(blocks_[i] + 4u);
       if (what_ == fields::state) {
-        r.trim = static_cast<std::int16_t>(word(blocks_[i] + 2u));
-        r.target = word(blocks_[i] + 6u);
+        r.trim = static_cast<std::int16_t>(reads_.word(blocks_[i] + 2u));
+        r.target = reads_.word(blocks_[i] + 6u);
       }
     }
   }
   fields what_;
   std::vector<joint_reading> readings_;
   std::vector<std::uint16_t> blocks_;
-  std::vector<ops::byte_range> plan_;
-  std::vector<std::uint8_t> memory_;
-  std::size_t step_ = 0;
+  ops::detail::planned_reads reads_;
   errc error_{};
 };
 
