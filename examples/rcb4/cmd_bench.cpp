@@ -1,4 +1,5 @@
-// rcb4 command-line tool: bench — round trips and control cycles per second next to the wire limit.
+// rcb4 command-line tool: bench — round trips and the robot's control cycle per second next to the
+// wire limit, and next to iory/rcb4's cycle on the same link.
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
@@ -33,7 +34,7 @@ int bench(session& s, const bench_options& o, const globals& g) {
   };
   int stage = 0;
   auto rate = [&](std::string_view label, auto&& one) {
-    progress bar(fmt::format("{} ({}/3)", label, ++stage), static_cast<std::size_t>(o.count), g.json);
+    progress bar(fmt::format("{} ({}/4)", label, ++stage), static_cast<std::size_t>(o.count), g.json);
     const auto t0 = std::chrono::steady_clock::now();
     for (long long i = 0; i < o.count; ++i) {
       one();
@@ -44,27 +45,48 @@ int bench(session& s, const bench_options& o, const globals& g) {
   const auto read = rcb4::move::read_ram(rcb4::ram::config, 2).value();
   const double ping_rate = rate("ping", [&] { s.c().execute(rcb4::ping{}); });
   const double read_rate = rate("read", [&] { s.c().execute(read); });
-  // Control cycle: read every allocated servo's state (planned reads), then move them all.
-  const auto cost = rcb4::ops::link_cost::at(s.baud(), 1ms);
-  const auto states = s.run(rcb4::ops::read_servo_states(cost));
-  rcb4::servo_set<rcb4::servo_position> hold;
-  for (const auto& st : states) hold.insert(st.ics, rcb4::servo_position::hold());
-  const auto move_all = rcb4::const_servo::make(hold, rcb4::frames{1});
-  std::size_t cycle_bytes = 0;
-  {
-    rcb4::ops::read_servo_states plan(cost);
-    while (auto c = plan.next()) {
-      const auto r = s.c().execute(*c);
-      cycle_bytes += rcb4::encode(*c).size() + rcb4::expected_reply(*c).frame_size();
-      plan.on_reply(r.view());
-    }
-    if (move_all) cycle_bytes += rcb4::encode(*move_all).size() + 4;
-  }
-  const double cycle_rate = rate("control cycle", [&] {
-    s.run(rcb4::ops::read_servo_states(cost));
-    if (move_all) s.c().execute(*move_all);
+  // The robot's control cycle: every joint's position, in the reads the planner picks for this
+  // link as measured, then one CONST of every joint. The targets are HOLD (stay where you are):
+  // nothing moves on a real robot.
+  const auto& model = robot_of(g);
+  const auto map = s.run(rcb4::robot::locate_joints(model));
+  const rcb4::robot::joint_targets targets(map);
+  if (targets.joints().empty())
+    throw failure(exit_board, fmt::format("the board has no servo allocated for any joint of the {}", model.name()),
+                  "rcb4 scan shows the board's slots; --robot FILE names another robot");
+  const auto cost = rcb4::transport::measure_link(s.c());
+  rcb4::robot::read_joints reads(map, rcb4::robot::fields::positions, cost);
+  const rcb4::command hold_all = targets.frame(rcb4::frames{1}).value();
+  const auto cycle_bytes_of = [](const auto& plan, const rcb4::command& write) {
+    std::size_t n = rcb4::encode(write).size() + rcb4::expected_reply(write).frame_size();
+    for (const auto& r : plan) n += 10 + r.size + 3;
+    return n;
+  };
+  const std::size_t cycle_bytes = cycle_bytes_of(reads.plan(), hold_all);
+  const double cycle_rate = rate("robot cycle", [&] {
+    reads.restart();
+    rcb4::transport::error_code ec;
+    rcb4::transport::run(s.c(), reads, ec);
+    if (ec) throw rcb4::transport::system_error(ec, "joint read");
+    s.c().execute(hold_all);
   });
-  const auto ping_limit = limit(3 + 4), read_limit = limit(10 + 5), cycle_limit = limit(cycle_bytes);
+  // iory/rcb4's scheme on the same link: the servo area in five 126-byte reads, then CONST36 (HOLD).
+  std::vector<rcb4::command> iory;
+  for (unsigned k = 0; k < 5; ++k)
+    iory.emplace_back(rcb4::move::read_ram(rcb4::ram_address::make(0x0090 + 126 * k).value(), 126).value());
+  rcb4::servo_set<rcb4::servo_position> all36;
+  for (int i = 0; i < 36; ++i) all36.insert(rcb4::ics_number::make(i).value(), rcb4::servo_position::hold());
+  iory.emplace_back(rcb4::const_servo::make(all36, rcb4::frames{1}).value());
+  std::size_t iory_bytes = 0;
+  for (const auto& x : iory) iory_bytes += rcb4::encode(x).size() + rcb4::expected_reply(x).frame_size();
+  const double iory_rate = rate("iory/rcb4 cycle", [&] {
+    for (const auto& x : iory) s.c().execute(x);
+  });
+  const double overhead_us = std::chrono::duration<double, std::micro>(cost.exchange).count();
+  std::vector<unsigned> read_sizes;
+  for (const auto& r : reads.plan()) read_sizes.push_back(static_cast<unsigned>(r.size));
+  const auto ping_limit = limit(3 + 4), read_limit = limit(10 + 5), cycle_limit = limit(cycle_bytes),
+             iory_limit = limit(iory_bytes);
   const auto opt = [](std::optional<double> v) { return v ? json(std::round(*v * 10) / 10) : json(nullptr); };
   if (g.json) {
     json j;
@@ -78,7 +100,13 @@ int bench(session& s, const bench_options& o, const globals& g) {
     j["cycle_hz"] = std::round(cycle_rate * 10) / 10;
     j["cycle_wire_limit_hz"] = opt(cycle_limit);
     j["cycle_bytes"] = cycle_bytes;
-    j["servos"] = states.size();
+    j["servos"] = targets.joints().size();
+    j["robot"] = model.name();
+    j["plan_reads"] = read_sizes;
+    j["exchange_overhead_us"] = std::round(overhead_us * 10) / 10;
+    j["iory_cycle_hz"] = std::round(iory_rate * 10) / 10;
+    j["iory_cycle_wire_limit_hz"] = opt(iory_limit);
+    j["iory_cycle_bytes"] = iory_bytes;
     emit(j);
     return exit_ok;
   }
@@ -87,15 +115,20 @@ int bench(session& s, const bench_options& o, const globals& g) {
              o.count, low ? ", CPU wake-up latency held at 0 us" : "");
   const auto row = [](std::string_view what, double got, std::optional<double> lim, std::string_view unit) {
     if (lim)
-      fmt::print("  {:<40} {:>9.1f} {:<3} wire limit {:>9.1f} {:<3} {:.2f}x\n", what, got, unit, *lim, unit,
+      fmt::print("  {:<46} {:>9.1f} {:<3} wire limit {:>9.1f} {:<3} {:.2f}x\n", what, got, unit, *lim, unit,
                  got / *lim);
     else
-      fmt::print("  {:<40} {:>9.1f} {}\n", what, got, unit);
+      fmt::print("  {:<46} {:>9.1f} {}\n", what, got, unit);
   };
   row("ping", ping_rate, ping_limit, "/s");
   row("MOV read 2 bytes", read_rate, read_limit, "/s");
-  row(fmt::format("control cycle ({}, {} bytes)", plural(states.size(), "servo"), cycle_bytes), cycle_rate, cycle_limit,
-      "Hz");
+  row(fmt::format("{} cycle ({} joints, {} B)", model.name(), targets.joints().size(), cycle_bytes), cycle_rate,
+      cycle_limit, "Hz");
+  row(fmt::format("iory/rcb4 cycle (5 x MOV 126 + CONST36, {} B)", iory_bytes), iory_rate, iory_limit, "Hz");
+  fmt::print("  {} cycle / iory/rcb4 cycle: {:.2f}x\n", model.name(), cycle_rate / iory_rate);
+  fmt::print(
+      "  link measured at {:.0f} us per exchange beyond the wire: the planner reads the joints in {} ({} bytes)\n",
+      overhead_us, plural(read_sizes.size(), "read"), fmt::join(read_sizes, "+"));
   if (s.is_virtual())
     fmt::print("  (the in-process virtual board is not paced: it can beat the wire limit; use rcb4 serve --pace)\n");
   return exit_ok;
@@ -104,7 +137,8 @@ int bench(session& s, const bench_options& o, const globals& g) {
 }  // namespace
 
 void add_bench_command(CLI::App& app, context& ctx) {
-  auto* cmd = app.add_subcommand("bench", "round trips and control cycles per second next to the wire limit");
+  auto* cmd = app.add_subcommand(
+      "bench", "round trips and the robot's control cycle per second next to the wire limit and iory/rcb4's cycle");
   auto o = std::make_shared<bench_options>();
   cmd->add_option("--count", o->count, "runs of each workload (default 500)")->check(int_range(1, 10000000));
   cmd->add_flag("--low-latency", o->low_latency,

@@ -91,7 +91,7 @@ expect_rc(["motion", "play", "121"], 2, "outside 1..120")
 expect_rc(["motion", "play", "120"], 1, "holds no program")  # an erased slot: refused before anything changes
 expect_ok(["motion", "status"], "no motion running")
 expect_rc(["motion", "play", "1", "--layout", "9.9"], 2, "--layout")
-expect_ok(["bench", "--count", "20"], "control cycle")
+expect_ok(["bench", "--count", "20"], "KHR-3HV cycle (20 joints")
 rc, out, err = run("bench", "--count", "20", "--low-latency")
 if os.access("/dev/cpu_dma_latency", os.W_OK):
     check(rc == 0 and "held at 0 us" in out, "bench --low-latency holds the PM QoS request")

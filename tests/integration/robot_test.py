@@ -135,6 +135,25 @@ dev = srv.stdout.readline().strip()
 try:
     rc, out, err = run("--device", dev, "joint", "list")
     check(rc == 1 and "allocates none of KHR-3HV's joints" in err, f"an empty allocation table: exit 1 ({err.strip()!r})")
+    rc, out, err = run("--device", dev, "bench", "--count", "5")
+    check(rc == 1 and "no servo allocated for any joint of the KHR-3HV" in err, f"bench on an empty table: exit 1 ({err.strip()!r})")
+finally:
+    srv.terminate()
+    srv.wait(timeout=10)
+
+# The robot's control cycle behind a USB adapter's millisecond (serve --pace --latency 1000):
+# the link is measured and the planner merges the joints' positions into long reads.
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+try:
+    rc, out, err = run("--json", "--device", dev, "--baud", "1250000", "bench", "--count", "10")
+    b = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and b["robot"] == "KHR-3HV" and b["servos"] == 20 and b["exchange_overhead_us"] >= 1000,
+          f"bench measures the link: at least the 1 ms the board waits ({b.get('exchange_overhead_us')})")
+    # ICS 0-9 and 12-21 in blocks 0x0090 + 20·ICS: 7 and 3 positions on each side of ICS 10-11's gap.
+    check(b.get("plan_reads") == [122, 42, 122, 42] and b["cycle_bytes"] == 4 * 13 + 328 + 49 + 4,
+          f"and reads the 20 positions in 4 reads ({b.get('plan_reads')}, {b.get('cycle_bytes')} bytes)")
+    check(b.get("iory_cycle_bytes") == 5 * (10 + 129) + 81 + 4, "next to iory/rcb4's 5 x MOV 126 + CONST36")
 finally:
     srv.terminate()
     srv.wait(timeout=10)

@@ -192,6 +192,29 @@ TEST_CASE("board_server: a paced reply never comes before the wire would have ca
   }
 }
 
+TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per exchange", "[transport][pace]") {
+  t::serve_options so;
+  so.pace = true;
+  so.latency = 2000us;
+  served_board b(so);
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  c.options().baud = 1250000;
+  t::error_code ec;
+  const auto cost = t::measure_link(c, ec, 5);
+  REQUIRE_FALSE(ec);
+  CHECK(cost.exchange >= 2000us);   // the board never answers sooner; the wire time is not counted in it
+  CHECK(cost.byte_time == 8800ns);  // 11 bits at 1.25 Mbaud
+  // Behind such a link the planner reads the 20 servos' positions (+4, 20 bytes apart) in long reads.
+  std::vector<ops::byte_range> positions;
+  for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
+  CHECK(ops::plan_reads(positions, cost).size() == 3);  // 7 + 7 + 6 positions: a read of 128 bytes spans 7
+  // The line failing is an error, not a cost.
+  b.server->stop();
+  t::measure_link(c, ec, 3);
+  CHECK(ec);
+}
+
 TEST_CASE("client: callback, future, coroutine and deferred completions", "[transport]") {
   served_board b;
   t::io_thread io;

@@ -116,6 +116,36 @@ TEST_CASE("robot ops: a move becomes CONST frames timed by the board's output pe
   CHECK(slow25.period() == output_period::ms25);
 }
 
+TEST_CASE("robot ops: a control loop's targets, set in degrees, go out as one CONST frame", "[robot]") {
+  board_wire w;
+  const auto m = arm(true);
+  locate_joints where(m);
+  run(w, where);
+  REQUIRE(where.error() == errc{});
+  joint_targets t(where.value());
+  REQUIRE(t.joints().size() == 3);  // "tail" has no block: it takes no target
+  CHECK(t.joints()[1]->name == "left_knee");
+  CHECK_FALSE(t.set("head_yaw", 30).has_value());
+  CHECK_FALSE(t.set(1, 10).has_value());  // left_knee
+  const auto refused = t.set("right_knee", 100);
+  REQUIRE(refused.has_value());
+  CHECK(refused->message == "right_knee: 100 degrees is beyond its upper limit 90");
+  CHECK(t.set("tail", 0)->message == "no located joint is called 'tail'");
+  CHECK(t.set(3, 0).has_value());
+  // protocol.md §4.7: SIZE 9+2·3, CMD 10, mask ICS 0, 16, 17 = 01 00 03 00 00, 1 frame, then in
+  // ICS order 8389 (head 30°), 7352 (left knee 10°: servo −5°), HOLD 7FFF (right knee, never set).
+  const auto frame = t.frame(frames{1}).value();
+  const std::vector<std::uint8_t> expected{0x0F, 0x10, 0x01, 0x00, 0x03, 0x00, 0x00, 0x01,
+                                           0xC5, 0x20, 0xB8, 0x1C, 0xFF, 0x7F, 0x5B};
+  const auto bytes = encode(frame).bytes();
+  CHECK(std::vector<std::uint8_t>(bytes.begin(), bytes.end()) == expected);
+  CHECK(w.send(frame).is_ack());
+  w.wait(50ms);
+  CHECK(w.read_word(0x0090 + 6) == 8389);  // head_yaw's output
+  // Nothing located: no frame.
+  CHECK(joint_targets(joint_map{}).frame(frames{1}).error() == errc::empty_servo_set);
+}
+
 TEST_CASE("robot ops: bad targets are refused before anything is sent", "[robot]") {
   const auto m = arm(true);
   auto why = [&](std::vector<joint_target> t) {

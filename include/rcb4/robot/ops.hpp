@@ -22,6 +22,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rcb4::robot {
@@ -306,6 +307,51 @@ class move_joints {
   const joint* unallocated_ = nullptr;
   std::size_t step_ = 0;
   errc error_{};
+};
+
+/**
+ * The write half of a control loop: a target per located joint, set in degrees (checked against
+ * the joint's limits) and sent as one CONST frame (protocol.md §5). Built once from a joint_map;
+ * set() and frame() allocate nothing unless a target is refused. Every joint starts at HOLD
+ * (stay where it is) until set. The joint_map must outlive it.
+ */
+class joint_targets {
+ public:
+  /** The located joints of @p map, each at HOLD. */
+  explicit joint_targets(const joint_map& map) {
+    for (const auto& e : map.entries())
+      if (e.block) {
+        joints_.push_back(e.j);
+        targets_.insert(e.j->ics, servo_position::hold());
+      }
+  }
+  /** The joints that take targets (the located ones), in the model's order. */
+  std::span<const joint* const> joints() const noexcept { return joints_; }
+  /**
+   * Sets joint @p i (an index into joints()) to @p degrees. A problem naming the joint and the
+   * limit when the angle is outside them; the previous target stays.
+   */
+  std::optional<problem> set(std::size_t i, double degrees) {
+    if (i >= joints_.size()) return problem{"joint index " + std::to_string(i) + " is beyond the located joints"};
+    auto p = to_position(*joints_[i], degrees);
+    if (!ok(p)) return std::get<problem>(std::move(p));
+    targets_.insert(joints_[i]->ics, std::get<servo_position>(p));
+    return std::nullopt;
+  }
+  /** Sets the joint called @p name (see set(std::size_t, double)). */
+  std::optional<problem> set(std::string_view name, double degrees) {
+    for (std::size_t i = 0; i < joints_.size(); ++i)
+      if (joints_[i]->name == name) return set(i, degrees);
+    return problem{"no located joint is called '" + std::string(name) + "'"};
+  }
+  /** The raw targets, by ICS slot. */
+  const servo_set<servo_position>& targets() const noexcept { return targets_; }
+  /** One CONST frame with every target, reached in @p f output periods; errc::empty_servo_set for no joint. */
+  result<const_servo> frame(frames f) const noexcept { return const_servo::make(targets_, f); }
+
+ private:
+  std::vector<const joint*> joints_;
+  servo_set<servo_position> targets_;
 };
 
 // --- trims -------------------------------------------------------------------------------------

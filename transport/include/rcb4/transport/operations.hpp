@@ -16,8 +16,11 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <functional>
 #include <thread>
+#include <vector>
 
 namespace rcb4::transport {
 
@@ -100,6 +103,40 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps) {
   error_code ec;
   switch_baud(c, bps, ec);
   if (ec) throw system_error(ec, "rcb4 switch baud");
+}
+
+/**
+ * Measures what one exchange costs on @p c beyond its bytes' time on the wire: adapter latency,
+ * the board's turnaround, the operating system. Times @p samples 2-byte reads of the config word
+ * (10 bytes out, 5 back), takes the median and subtracts those 15 bytes' wire time at the
+ * client's rate (options().baud). The result is the read planner's cost of this link
+ * (ops::plan_reads, protocol.md §4): on a fast link it reads joints one by one, behind a
+ * millisecond of USB latency it merges them into long reads. Sets @p ec if an exchange fails.
+ */
+template <AsyncByteStream Stream>
+ops::link_cost measure_link(basic_client<Stream>& c, error_code& ec, int samples = 9) {
+  const command read = move::read_ram(ram::config, 2).value();
+  std::vector<std::chrono::nanoseconds> times;
+  c.execute(read, ec);  // the first exchange may pay for a cold path; it is not counted
+  for (int i = 0; i < samples && !ec; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    c.execute(read, ec);
+    times.push_back(std::chrono::steady_clock::now() - t0);
+  }
+  if (ec || times.empty()) return {};
+  std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+  const auto baud = c.options().baud > 0 ? c.options().baud : 115200u;
+  const auto overhead = times[times.size() / 2] - wire_time(15, baud);
+  return ops::link_cost::at(baud, std::max(overhead, std::chrono::nanoseconds(0)));
+}
+
+/** measure_link that throws system_error. */
+template <AsyncByteStream Stream>
+ops::link_cost measure_link(basic_client<Stream>& c, int samples = 9) {
+  error_code ec;
+  const auto cost = measure_link(c, ec, samples);
+  if (ec) throw system_error(ec, "rcb4 measure link");
+  return cost;
 }
 
 /** Called with each motion state wait_motion reads (for a progress display). */
