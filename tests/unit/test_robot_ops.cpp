@@ -132,6 +132,8 @@ TEST_CASE("robot ops: a control loop's targets, set in degrees, go out as one CO
   CHECK(refused->message == "right_knee: 100 degrees is beyond its upper limit 90");
   CHECK(t.set("tail", 0)->message == "no located joint is called 'tail'");
   CHECK(t.set(3, 0).has_value());
+  CHECK(t.set(*m.find("tail"), 0).has_value());
+  CHECK_FALSE(t.set(*m.find("head_yaw"), 30).has_value());  // by the joint a reading names
   // protocol.md §4.7: SIZE 9+2·3, CMD 10, mask ICS 0, 16, 17 = 01 00 03 00 00, 1 frame, then in
   // ICS order 8389 (head 30°), 7352 (left knee 10°: servo −5°), HOLD 7FFF (right knee, never set).
   const auto frame = t.frame(frames{1}).value();

@@ -194,6 +194,17 @@ TEST_CASE("board: SINGLE and CONST interpolate over frames, FREE and HOLD", "[bo
   CHECK(w.send(single_servo{2, servo_position::free(), 10}).is_ack());
   CHECK(w.read_word(ics2_out) == 0x8000);
   CHECK(w.read_word(ics2_pos) == 7000);
+  // From FREE (or HOLD) a move starts where the servo was measured, here turned by hand to 8000.
+  CHECK(w.board().turn_by_hand(ics_number{2}, 8000));
+  CHECK(w.send(single_servo{2, 7000, 10}).is_ack());
+  w.wait(50ms);
+  CHECK(w.read_word(ics2_pos) == 7500);
+  CHECK(w.send(single_servo{2, servo_position::hold(), 10}).is_ack());
+  CHECK(w.read_word(ics2_out) == 0x7FFF);
+  CHECK(w.read_word(ics2_pos) == 7500);
+  CHECK(w.send(single_servo{2, 8500, 10}).is_ack());
+  w.wait(50ms);
+  CHECK(w.read_word(ics2_pos) == 8000);
   CHECK(w.send(single_servo{30, 7500, 10}).is_nack());  // unallocated
   // CONST: several servos, unallocated ones ignored, ascending order respected.
   CHECK(w.send(const_servo::make({{1, 9000}, {0, 6000}, {30, 7000}}, 4).value()).is_ack());

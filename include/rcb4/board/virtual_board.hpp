@@ -523,8 +523,11 @@ class virtual_board {
     const std::uint32_t b = *block;
     put16(b + servo_block::interp_end.offset, pos.value());
     ram_[b + servo_block::interp_speed.offset] = speed.value();
-    const bool immediate = speed.value() == 0 || pos.is_free() || pos.is_hold() ||
-                           servo_position::make(ram16(b + servo_block::target.offset)).value_or(pos).is_free();
+    // A free or held servo is where it was measured (moved by hand, perhaps): a move starts there.
+    const auto out = servo_position::make(ram16(b + servo_block::target.offset));
+    if (!out || out->is_free() || out->is_hold())
+      put16(b + servo_block::target.offset, ram16(b + servo_block::position.offset));
+    const bool immediate = speed.value() == 0 || pos.is_free() || pos.is_hold();
     if (immediate) {
       put16(b + servo_block::target.offset, pos.value());
       ram_[b + servo_block::interp_steps.offset] = 0;

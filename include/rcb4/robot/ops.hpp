@@ -338,6 +338,12 @@ class joint_targets {
     targets_.insert(joints_[i]->ics, std::get<servo_position>(p));
     return std::nullopt;
   }
+  /** Sets joint @p j, as read_joints' readings name it (see set(std::size_t, double)). */
+  std::optional<problem> set(const joint& j, double degrees) {
+    for (std::size_t i = 0; i < joints_.size(); ++i)
+      if (joints_[i] == &j) return set(i, degrees);
+    return set(j.name, degrees);
+  }
   /** Sets the joint called @p name (see set(std::size_t, double)). */
   std::optional<problem> set(std::string_view name, double degrees) {
     for (std::size_t i = 0; i < joints_.size(); ++i)
