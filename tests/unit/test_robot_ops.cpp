@@ -139,8 +139,8 @@ TEST_CASE("robot ops: a control loop's targets, set in degrees, go out as one CO
   const auto frame = t.frame(frames{1}).value();
   const std::vector<std::uint8_t> expected{0x0F, 0x10, 0x01, 0x00, 0x03, 0x00, 0x00, 0x01,
                                            0xC5, 0x20, 0xB8, 0x1C, 0xFF, 0x7F, 0x5B};
-  const auto bytes = encode(frame).bytes();
-  CHECK(std::vector<std::uint8_t>(bytes.begin(), bytes.end()) == expected);
+  const auto encoded = encode(frame);
+  CHECK(std::vector<std::uint8_t>(encoded.bytes().begin(), encoded.bytes().end()) == expected);
   CHECK(w.send(frame).is_ack());
   w.wait(50ms);
   CHECK(w.read_word(0x0090 + 6) == 8389);  // head_yaw's output
