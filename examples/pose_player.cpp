@@ -19,6 +19,7 @@
 #include <future>
 #include <iostream>
 #include <map>
+#include <string_view>
 #include <thread>
 
 using namespace std::chrono_literals;
@@ -55,6 +56,10 @@ void move_and_settle(t::basic_client<t::serial_port>& c, const robot::model& m, 
 }  // namespace
 
 int main(int argc, char** argv) try {
+  if (argc > 1 && argv[1][0] == '-') {
+    std::printf("usage: rcb4_pose_player [DEVICE [khr-3hv|kxr-l2|PROFILE.yaml]]  (no device: a virtual KHR-3HV)\n");
+    return std::string_view(argv[1]) == "--help" || std::string_view(argv[1]) == "-h" ? 0 : 2;
+  }
   example::connection board(argc > 1 && argv[1][0] ? 2 : 1, argv);
   auto& c = *board;
   const auto model = robot::open_profile(argc > 2 ? argv[2] : "khr-3hv");

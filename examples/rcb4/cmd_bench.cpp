@@ -70,13 +70,14 @@ int bench(session& s, const bench_options& o, const globals& g) {
     if (ec) throw rcb4::transport::system_error(ec, "joint read");
     s.c().execute(hold_all);
   });
-  // iory/rcb4's scheme on the same link: the servo area in five 126-byte reads, then CONST36 (HOLD).
+  // iory/rcb4's scheme on the same link: the servo area in five 126-byte reads, then CONST36 of
+  // HOLD. ICS 35 is the receiver's slot (protocol.md §5): on a real board it is left out (CONST35).
   std::vector<rcb4::command> iory;
   for (unsigned k = 0; k < 5; ++k)
     iory.emplace_back(rcb4::move::read_ram(rcb4::ram_address::make(0x0090 + 126 * k).value(), 126).value());
-  rcb4::servo_set<rcb4::servo_position> all36;
-  for (int i = 0; i < 36; ++i) all36.insert(rcb4::ics_number::make(i).value(), rcb4::servo_position::hold());
-  iory.emplace_back(rcb4::const_servo::make(all36, rcb4::frames{1}).value());
+  rcb4::servo_set<rcb4::servo_position> all;
+  for (int i = 0; i < 35; ++i) all.insert(rcb4::ics_number::make(i).value(), rcb4::servo_position::hold());
+  iory.emplace_back(rcb4::const_servo::make(all, rcb4::frames{1}).value());
   std::size_t iory_bytes = 0;
   for (const auto& x : iory) iory_bytes += rcb4::encode(x).size() + rcb4::expected_reply(x).frame_size();
   const double iory_rate = rate("iory/rcb4 cycle", [&] {
@@ -124,7 +125,7 @@ int bench(session& s, const bench_options& o, const globals& g) {
   row("MOV read 2 bytes", read_rate, read_limit, "/s");
   row(fmt::format("{} cycle ({} joints, {} B)", model.name(), targets.joints().size(), cycle_bytes), cycle_rate,
       cycle_limit, "Hz");
-  row(fmt::format("iory/rcb4 cycle (5 x MOV 126 + CONST36, {} B)", iory_bytes), iory_rate, iory_limit, "Hz");
+  row(fmt::format("iory/rcb4 cycle (5 x MOV 126 + CONST35, {} B)", iory_bytes), iory_rate, iory_limit, "Hz");
   fmt::print("  {} cycle / iory/rcb4 cycle: {:.2f}x\n", model.name(), cycle_rate / iory_rate);
   fmt::print(
       "  link measured at {:.0f} us per exchange beyond the wire: the planner reads the joints in {} ({} bytes)\n",

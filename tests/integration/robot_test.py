@@ -153,7 +153,7 @@ try:
     # ICS 0-9 and 12-21 in blocks 0x0090 + 20·ICS: 7 and 3 positions on each side of ICS 10-11's gap.
     check(b.get("plan_reads") == [122, 42, 122, 42] and b["cycle_bytes"] == 4 * 13 + 328 + 49 + 4,
           f"and reads the 20 positions in 4 reads ({b.get('plan_reads')}, {b.get('cycle_bytes')} bytes)")
-    check(b.get("iory_cycle_bytes") == 5 * (10 + 129) + 81 + 4, "next to iory/rcb4's 5 x MOV 126 + CONST36")
+    check(b.get("iory_cycle_bytes") == 5 * (10 + 129) + 79 + 4, "next to iory/rcb4's 5 x MOV 126 + CONST35 (ICS 35 is the receiver's)")
 finally:
     srv.terminate()
     srv.wait(timeout=10)

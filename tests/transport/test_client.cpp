@@ -209,8 +209,8 @@ TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per 
   std::vector<ops::byte_range> positions;
   for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
   CHECK(ops::plan_reads(positions, cost).size() == 3);  // 7 + 7 + 6 positions: a read of 128 bytes spans 7
-  // The line failing is an error, not a cost.
-  b.server->stop();
+  // The line failing is an error, not a cost (shutdown stops the server on its own thread).
+  t::board_server::shutdown(b.server);
   t::measure_link(c, ec, 3);
   CHECK(ec);
 }

@@ -82,6 +82,24 @@ TEST_CASE("robot ops: joints are located through the allocation table and read i
   CHECK(fast.value()[2].position == 7000);
 }
 
+TEST_CASE("robot ops: a servo that never answered has no angle", "[robot]") {
+  board::options o;
+  o.unanswered.insert(ics_number{16});  // left_knee's servo: its measured position stays 0
+  board_wire w(o);
+  const auto m = arm();
+  locate_joints where(m);
+  run(w, where);
+  read_joints rd(where.value(), fields::state);
+  run(w, rd);
+  REQUIRE(rd.error() == errc{});
+  const auto& knee = rd.value()[1];
+  CHECK(knee.allocated);
+  CHECK(knee.position == 0);
+  CHECK_FALSE(knee.answered());
+  CHECK_FALSE(knee.degrees().has_value());  // not -253 degrees
+  CHECK(rd.value()[0].degrees().value() == Approx(0.0));
+}
+
 TEST_CASE("robot ops: a move becomes CONST frames timed by the board's output period", "[robot]") {
   board_wire w;
   const auto m = arm();

@@ -27,6 +27,15 @@
 
 namespace rcb4::robot {
 
+namespace detail {
+/** The slot of joint @p j among @p slots (from the allocation table), or nullptr: no block. */
+inline const ops::servo_slot* slot_of(std::span<const ops::servo_slot> slots, const joint& j) noexcept {
+  for (const auto& s : slots)
+    if (s.ics == j.ics) return &s;
+  return nullptr;
+}
+}  // namespace detail
+
 /** A joint and its servo block's RAM address (nothing when the board allocates no block to it). */
 struct located {
   const joint* j = nullptr;            ///< the model's joint
@@ -40,10 +49,8 @@ class joint_map {
   /** Maps every joint of @p m through @p slots (the allocated slots, ops::scan_servos). */
   joint_map(const model& m, std::span<const ops::servo_slot> slots) {
     for (const auto& j : m.joints()) {
-      located l{&j, std::nullopt};
-      for (const auto& s : slots)
-        if (s.ics == j.ics) l.block = s.address;
-      entries_.push_back(l);
+      const auto* s = detail::slot_of(slots, j);
+      entries_.push_back({&j, s ? std::optional<std::uint16_t>(s->address) : std::nullopt});
     }
   }
   /** One entry per joint, in the model's order. */
@@ -105,8 +112,10 @@ struct joint_reading {
   std::uint16_t position = 0;  ///< +4: measured position
   std::uint16_t target = 0;    ///< +6: output position, FREE 0x8000, HOLD 0x7FFF (fields::state only)
 
-  /** The joint's angle, from the measured position; nothing when unallocated or not an angle. */
-  std::optional<double> degrees() const { return allocated ? to_degrees(*j, position) : std::nullopt; }
+  /** False for a measured position of 0: the servo never answered (a KRS reads 3500..11500). */
+  bool answered() const noexcept { return allocated && position != 0; }
+  /** The joint's angle, from the measured position; nothing when unallocated, silent or not an angle. */
+  std::optional<double> degrees() const { return answered() ? to_degrees(*j, position) : std::nullopt; }
   /** The target's angle; nothing when free, held, unallocated or not read. */
   std::optional<double> target_degrees() const { return allocated ? to_degrees(*j, target) : std::nullopt; }
   /** True when the output is FREE (no torque). */
@@ -258,7 +267,7 @@ class move_joints {
       if ((error_ = ops::detail::check_reply(r, true, 70)) != errc{}) return;
       const auto slots = ops::detail::allocated_slots(r);
       for (const auto& m : moves_)
-        if (std::none_of(slots.begin(), slots.end(), [&](const auto& s) { return s.ics == m.j->ics; })) {
+        if (!detail::slot_of(slots, *m.j)) {
           error_ = errc::servo_not_allocated;
           unallocated_ = m.j;
           return;
@@ -407,8 +416,8 @@ class write_trims {
       if ((error_ = ops::detail::check_reply(r, true, 70)) != errc{}) return;
       const auto slots = ops::detail::allocated_slots(r);
       for (const auto& t : trims_) {
-        const auto s = std::find_if(slots.begin(), slots.end(), [&](const auto& x) { return x.ics == t.j->ics; });
-        if (s == slots.end()) {
+        const auto* s = detail::slot_of(slots, *t.j);
+        if (!s) {
           error_ = errc::servo_not_allocated;
           unallocated_ = t.j;
           commands_.clear();
