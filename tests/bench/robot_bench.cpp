@@ -13,6 +13,7 @@
 // PM QoS request when the process may (root).
 // SPDX-License-Identifier: BSL-1.0
 #include "pty_echo.hpp"
+#include "rounds.hpp"
 #include "served_board.hpp"
 
 #include <rcb4/robot/ops.hpp>
@@ -35,11 +36,9 @@ using namespace rcb4;
 namespace t = rcb4::transport;
 using clock_type = std::chrono::steady_clock;
 constexpr std::uint32_t baud = 1250000;
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
+using rcb4::bench::median;
+using rcb4::bench::ratio;
+using rcb4::bench::take_turns;
 
 /** The wire time of @p bytes at 1.25 Mbaud in µs. */
 double wire_us(std::size_t bytes) { return static_cast<double>(bytes) * 11.0 / 1.25; }
@@ -151,18 +150,9 @@ void run_at(const robot::model& m, std::chrono::microseconds latency) {
       [&] { return timed([&] { robot_cycle(c, other); }); },
   };
   for (const auto& l : loops) l();  // warm up
-  std::vector<std::vector<double>> us(loops.size());
-  for (int r = 0; r < rounds; ++r)
-    for (std::size_t k = 0; k < loops.size(); ++k) {
-      const std::size_t i = (k + static_cast<std::size_t>(r)) % loops.size();
-      us[i].push_back(loops[i]());
-    }
+  const auto us = take_turns(loops, rounds);
   ::close(fd);
-  const auto per_round_ratio = [&](std::size_t x, std::size_t y) {  // median over rounds of us[x] / us[y]
-    std::vector<double> q;
-    for (std::size_t i = 0; i < us[x].size(); ++i) q.push_back(us[x][i] / us[y][i]);
-    return median(q);
-  };
+  const auto per_round_ratio = [&](std::size_t x, std::size_t y) { return ratio(us[x], us[y]); };
   const double ours_lim = ours.limit_us(latency), iory_lim = theirs.limit_us(latency);
   std::printf(
       "\n  adapter latency %lld us (board paced at %u baud); link measured: %.1f us per exchange beyond "
@@ -214,16 +204,6 @@ int main() {
   std::printf("rcb4 robot control loop: read every joint's position, write every joint's target (%s, %zu joints)\n",
               m.name().c_str(), m.joints().size());
   std::printf("goals: >= 0.90x the plan's wire+latency limit; >= 1.5x iory/rcb4's rate at 0 latency\n");
-  std::printf("\nCPU idle states as configured (wake-up latency bound %lld us):\n",
-              static_cast<long long>(t::cpu_latency_bound_us()));
-  pass(m);
-  t::cpu_latency_guard low(std::chrono::microseconds(0));
-  if (!low.active()) {
-    std::printf("\n(no second pass: a PM QoS request needs write access to /dev/cpu_dma_latency: %s)\n",
-                low.error().message().c_str());
-    return 0;
-  }
-  std::printf("\nholding the CPUs' wake-up latency at 0 us (cpu_latency_guard, as a control loop would):\n");
-  pass(m);
-  return 0;
+  std::printf("\n");
+  return rcb4::bench::two_passes([&] { pass(m); });
 }

@@ -18,6 +18,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "alloc_count.hpp"
 #include "pty_echo.hpp"
+#include "rounds.hpp"
 #include "served_board.hpp"
 
 #include <rcb4/transport/board_server.hpp>
@@ -37,36 +38,12 @@ namespace {
 using namespace rcb4;
 namespace t = rcb4::transport;
 using clock_type = std::chrono::steady_clock;
+using rcb4::bench::median;
+using rcb4::bench::ratio;
+using rcb4::bench::take_turns;
 
 double us_since(clock_type::time_point start, int n) {
   return std::chrono::duration<double, std::micro>(clock_type::now() - start).count() / n;
-}
-
-/** The median of @p v. */
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-/**
- * Runs the measurements @p m (each returns µs per operation) for @p rounds rounds, rotating
- * their order every round; per measurement, its times.
- */
-std::vector<std::vector<double>> take_turns(const std::vector<std::function<double()>>& m, int rounds) {
-  std::vector<std::vector<double>> us(m.size());
-  for (int r = 0; r < rounds; ++r)
-    for (std::size_t k = 0; k < m.size(); ++k) {
-      const std::size_t i = (k + static_cast<std::size_t>(r)) % m.size();
-      us[i].push_back(m[i]());
-    }
-  return us;
-}
-
-/** The median over rounds of a[r] / b[r]: how fast b is next to a (times in µs). */
-double ratio(const std::vector<double>& a, const std::vector<double>& b) {
-  std::vector<double> r;
-  for (std::size_t i = 0; i < a.size(); ++i) r.push_back(a[i] / b[i]);
-  return median(r);
 }
 
 /** A workload: commands sent in turn, one "operation" being the whole list once. */
@@ -307,16 +284,5 @@ int main(int argc, char** argv) {
   if (!device.empty()) return external(device, device_baud, loads);
   std::printf("rcb4 transport benchmarks: pty, virtual board (unpaced unless said); operations per second\n");
   std::printf("(a control loop's operation is its 6 exchanges); ratios are medians of per-round ratios\n\n");
-  std::printf("CPU idle states as configured (wake-up latency bound %lld us):\n",
-              static_cast<long long>(t::cpu_latency_bound_us()));
-  pass(loads, write36);
-  t::cpu_latency_guard low(std::chrono::microseconds(0));
-  if (!low.active()) {
-    std::printf("\n(no second pass: a PM QoS request needs write access to /dev/cpu_dma_latency: %s)\n",
-                low.error().message().c_str());
-    return 0;
-  }
-  std::printf("\nholding the CPUs' wake-up latency at 0 us (cpu_latency_guard, as a control loop would):\n");
-  pass(loads, write36);
-  return 0;
+  return rcb4::bench::two_passes([&] { pass(loads, write36); });
 }
