@@ -6,8 +6,11 @@
 //   - a complete parse is a frame with a correct checksum, the expected echo and an allowed
 //     length, and re-encodes to exactly the consumed bytes;
 //   - split invariance: feeding any prefix, then exactly what is asked for, gives the same result;
-//   - parse_reply_frame (shape-free) agrees on the frame length.
+//   - parse_reply_frame (shape-free) agrees on the frame length;
+//   - the stream's first 70 bytes, read as an ICS allocation table, give whole, even,
+//     non-overlapping blocks inside the user area, or errc::bad_allocation_table.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/ops/servos.hpp>
 #include <rcb4/rcb4.hpp>
 
 #include <algorithm>
@@ -16,6 +19,31 @@ namespace {
 void check(bool ok) {
   if (!ok) __builtin_trap();
 }
+
+void check_allocation_table(std::span<const std::uint8_t> table) {
+  const auto slots = rcb4::ops::parse_allocation_table(table);
+  if (!slots) {
+    check(slots.error() == rcb4::errc::bad_allocation_table);
+    return;
+  }
+  std::uint32_t previous_end = 0;
+  unsigned previous_ics = 0;
+  bool first = true;
+  auto sorted = *slots;
+  for (const auto& s : *slots) {
+    check(first || s.ics.value() > previous_ics);  // ascending by ICS, each once
+    previous_ics = s.ics.value();
+    first = false;
+    check(s.address >= 0x0090 && s.address + 20u <= 0x0490 && s.address % 2 == 0);
+    const std::size_t k = s.ics.value();
+    check(s.address == (table[2 * k] | (table[2 * k + 1] << 8)));
+  }
+  std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& b) { return a.address < b.address; });
+  for (const auto& s : sorted) {
+    check(s.address >= previous_end);
+    previous_end = s.address + 20u;
+  }
+}
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -23,6 +51,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::uint8_t n = static_cast<std::uint8_t>(data[2] % 252 + 1);
   const rcb4::reply_shape shape{data[0], (data[1] & 1) != 0, (data[1] & 1) ? n : std::uint8_t{0}};
   const std::span<const std::uint8_t> in(data + 3, size - 3);
+  if (in.size() >= 70) check_allocation_table(in.first(70));
 
   const auto r = rcb4::parse_reply(in, shape);
   check(r.consumed <= in.size());

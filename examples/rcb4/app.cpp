@@ -272,6 +272,10 @@ failure explain(const std::error_code& ec, std::string_view what) {
     if (ec == rcb4::errc::nack)
       return {exit_board, std::string(what),
               "the board refused the command (range, unallocated servo, or a busy program)"};
+    if (ec == rcb4::errc::bad_allocation_table)
+      return {exit_board, std::string(what),
+              "`rcb4 read ram 0x0044 70` shows the table (ICS k's block address at +2k, little-endian); writing "
+              "the project again from HeartToHeart4 rewrites it"};
     if (ec == rcb4::errc::bad_checksum)
       return {exit_board, std::string(what), "replies fail their checksum: a wrong baud or parity, or a noisy line"};
     return {exit_board, std::string(what)};

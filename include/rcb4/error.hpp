@@ -56,10 +56,11 @@ enum class errc : std::uint8_t {
   motion_slot_empty,        ///< the motion's ROM slot holds no program (erased: 0xFF)
   motion_slot_not_a_frame,  ///< the slot's first bytes fail a frame's checksum: another ROM layout?
   servo_not_allocated,      ///< a servo the operation names has no block in the ICS allocation table
+  bad_allocation_table,     ///< an ICS allocation entry is no servo block: odd, overlapping, outside the user area
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::servo_not_allocated;
+inline constexpr errc errc_last = errc::bad_allocation_table;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -108,6 +109,9 @@ constexpr const char* message(errc e) noexcept {
     case errc::servo_not_allocated:
       return "a servo named has no block in the board's ICS allocation table (RAM 0x0044): the board would "
              "ignore it";
+    case errc::bad_allocation_table:
+      return "the board's ICS allocation table (RAM 0x0044) is not a servo map: an entry points at an odd "
+             "address, outside the user area 0x0090-0x048F, or into another servo's block";
   }
   return "unknown rcb4 error";
 }

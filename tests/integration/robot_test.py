@@ -3,6 +3,7 @@
 # KHR-3HV) in one process, joint/pose/trim/scan/motion commands from others, checked through
 # their exit codes, their JSON and the board's own answers. Expected angles are worked out by hand.
 # SPDX-License-Identifier: BSL-1.0
+import contextlib
 import json
 import os
 import subprocess
@@ -19,9 +20,15 @@ def run(*args, stdin=None, timeout=60):
     return p.returncode, p.stdout, p.stderr
 
 
-srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
-dev = srv.stdout.readline().strip()
-on = ["--device", dev]
+@contextlib.contextmanager
+def serve(*args):
+    """`rcb4 serve --pty ARGS` for the duration of a with block; yields its device path."""
+    srv = subprocess.Popen([RCB4, "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
+    try:
+        yield srv.stdout.readline().strip()
+    finally:
+        srv.terminate()
+        srv.wait(timeout=10)
 
 
 def joints():
@@ -30,7 +37,8 @@ def joints():
     return {j["name"]: j for j in json.loads(out)}
 
 
-try:
+with serve() as dev:
+    on = ["--device", dev]
     js = joints()
     check(len(js) >= 17 and all(j["allocated"] for j in js.values()),
           f"--json joint list on serve --pty: {len(js)} joints, every one on an allocated slot")
@@ -109,14 +117,9 @@ try:
     sc = json.loads(out) if rc == 0 else {}
     check(len(sc.get("slots", [])) == 20 and all(s["answers"] for s in sc["slots"]) and sc["unallocated_joints"] == [],
           "scan: 20 slots, each answering, each a joint")
-finally:
-    srv.terminate()
-    srv.wait(timeout=10)
 
 # A board with silent servos and slots the robot does not have.
-srv = subprocess.Popen([RCB4, "serve", "--pty", "--servos", "4"], stdout=subprocess.PIPE, text=True)
-dev = srv.stdout.readline().strip()
-try:
+with serve("--servos", "4") as dev:
     rc, out, err = run("--device", dev, "scan")
     check(rc == 0 and "4 slots allocated" in out and "16 joints of KHR-3HV without a slot" in out,
           f"scan on a 4-slot board names the joints without a slot ({out.strip().splitlines()[-1]!r})")
@@ -126,26 +129,40 @@ try:
     js = {j["name"]: j for j in json.loads(out)} if rc == 0 else {}
     check(rc == 0 and js["head_yaw"]["allocated"] and not js["left_knee"]["allocated"] and js["left_knee"]["degrees"] is None,
           "joint list marks the joints without a slot, with no made-up angle")
-finally:
-    srv.terminate()
-    srv.wait(timeout=10)
 
-srv = subprocess.Popen([RCB4, "serve", "--pty", "--servos", "0"], stdout=subprocess.PIPE, text=True)
-dev = srv.stdout.readline().strip()
-try:
+with serve("--servos", "0") as dev:
     rc, out, err = run("--device", dev, "joint", "list")
     check(rc == 1 and "allocates none of KHR-3HV's joints" in err, f"an empty allocation table: exit 1 ({err.strip()!r})")
     rc, out, err = run("--device", dev, "bench", "--count", "5")
     check(rc == 1 and "no servo allocated for any joint of the KHR-3HV" in err, f"bench on an empty table: exit 1 ({err.strip()!r})")
-finally:
-    srv.terminate()
-    srv.wait(timeout=10)
+
+# A board whose allocation table is nonsense (every block one byte off, a duplicate, one outside
+# RAM's user area): every reader and writer refuses it with exit 1, no made-up angle, no write.
+BAD_TABLE = "the board's ICS allocation table (RAM 0x0044) is not a servo map"
+for name, entries in [("shifted by one byte", {k: 0x0091 + 20 * k for k in [*range(10), *range(12, 22)]}),
+                      ("a duplicate", {0: 0x0090, 1: 0x00A4, 2: 0x00A4}),
+                      ("outside the user area", {0: 0x0090, 1: 0x0500})]:
+    table = bytearray([0xFF] * 70)
+    for k, a in entries.items():
+        table[2 * k:2 * k + 2] = a.to_bytes(2, "little")
+    with serve() as dev:
+        on = ["--device", dev]
+        rc, out, err = run(*on, "write", "ram", "0x0044", table.hex())
+        assert rc == 0, err
+        rc, trim_before, err = run(*on, "read", "ram", "0x01D2", "2")
+        for args in (["joint", "list"], ["trim", "get"], ["servo", "list"], ["scan"], ["pose", "capture", "/tmp/rcb4-bad-table-pose.json"],
+                     ["trim", "set", "left_knee=2"], ["joint", "move", "left_knee=10"], ["joint", "free", "all"]):
+            rc, out, err = run(*on, *args)
+            check(rc == 1 and BAD_TABLE in err and "rcb4 read ram 0x0044 70" in err,
+                  f"{name}: `rcb4 {' '.join(args)}` is exit 1 naming the table ({rc}, {err.strip()[:90]!r})")
+        rc, out, err = run("--json", *on, "joint", "list")
+        check(rc == 1 and BAD_TABLE in json.loads(out or "{}").get("error", ""), f"{name}: and as JSON")
+        rc, trim_after, err = run(*on, "read", "ram", "0x01D2", "2")
+        check(rc == 0 and trim_after == trim_before, f"{name}: no trim was written ({trim_after.strip()!r})")
 
 # The robot's control cycle behind a USB adapter's millisecond (serve --pace --latency 1000):
 # the link is measured and the planner merges the joints' positions into long reads.
-srv = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
-dev = srv.stdout.readline().strip()
-try:
+with serve("--pace", "--latency", "1000") as dev:
     rc, out, err = run("--json", "--device", dev, "--baud", "1250000", "bench", "--count", "10")
     b = json.loads(out) if rc == 0 else {}
     check(rc == 0 and b["robot"] == "KHR-3HV" and b["servos"] == 20 and b["exchange_overhead_us"] >= 1000,
@@ -154,9 +171,6 @@ try:
     check(b.get("plan_reads") == [122, 42, 122, 42] and b["cycle_bytes"] == 4 * 13 + 328 + 49 + 4,
           f"and reads the 20 positions in 4 reads ({b.get('plan_reads')}, {b.get('cycle_bytes')} bytes)")
     check(b.get("iory_cycle_bytes") == 5 * (10 + 129) + 79 + 4, "next to iory/rcb4's 5 x MOV 126 + CONST35 (ICS 35 is the receiver's)")
-finally:
-    srv.terminate()
-    srv.wait(timeout=10)
 
 # Profiles: the shipped files, another robot, bad files.
 rc, out, err = run("--robot", os.path.join(PROFILES, "kxr-l2.yaml"), "joint", "list")

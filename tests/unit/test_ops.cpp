@@ -167,6 +167,72 @@ TEST_CASE("ops: an allocation table of zeros (no project) has no servos, not mad
   CHECK(states.value().empty());  // not 22 servos read from the config word and the program counter
 }
 
+namespace {
+/** An allocation table (70 bytes) from ICS → block address; every other entry 0xFFFF. */
+std::vector<std::uint8_t> table_of(std::initializer_list<std::pair<unsigned, std::uint16_t>> entries) {
+  std::vector<std::uint8_t> t(70, 0xFF);
+  for (const auto& [k, a] : entries) {
+    t[2 * k] = static_cast<std::uint8_t>(a & 0xFF);
+    t[2 * k + 1] = static_cast<std::uint8_t>(a >> 8);
+  }
+  return t;
+}
+}  // namespace
+
+TEST_CASE("ops: the allocation table parser takes blocks anywhere in the user area, none odd or overlapping",
+          "[ops][servo]") {
+  // HeartToHeart4's layout: 0x0090 + 20k (protocol.md §6), written out by hand.
+  const auto hth4 = ops::parse_allocation_table(table_of({{0, 0x0090}, {1, 0x00A4}, {2, 0x00B8}}));
+  REQUIRE(hth4.has_value());
+  REQUIRE(hth4->size() == 3);
+  CHECK((*hth4)[1] == ops::servo_slot{ics_number::make(1).value(), 0x00A4});
+  // Another layout (§7: read the table, do not assume 0x0090 + 20k): even, apart, inside the area.
+  const auto moved = ops::parse_allocation_table(table_of({{0, 0x0400}, {5, 0x0092}, {7, 0x047C}}));
+  REQUIRE(moved.has_value());
+  CHECK(moved->size() == 3);
+  CHECK(ops::parse_allocation_table(table_of({})).value().empty());
+  CHECK(ops::parse_allocation_table(std::vector<std::uint8_t>(70, 0x00)).value().empty());  // no project
+  // Refused whole: not one made-up servo.
+  CHECK(ops::parse_allocation_table(table_of({{0, 0x0090}, {1, 0x0091}})).error() == errc::bad_allocation_table);
+  CHECK(ops::parse_allocation_table(table_of({{0, 0x0090}, {3, 0x0090}})).error() == errc::bad_allocation_table);
+  CHECK(ops::parse_allocation_table(table_of({{0, 0x0090}, {1, 0x00A2}})).error() == errc::bad_allocation_table);
+  CHECK(ops::parse_allocation_table(table_of({{4, 0x0010}})).error() == errc::bad_allocation_table);  // config area
+  CHECK(ops::parse_allocation_table(table_of({{4, 0x047E}})).error() == errc::bad_allocation_table);  // past 0x048F
+  CHECK(ops::parse_allocation_table(table_of({{4, 0x8000}})).error() == errc::bad_allocation_table);
+  CHECK(ops::parse_allocation_table(std::vector<std::uint8_t>(69, 0xFF)).error() == errc::bad_allocation_table);
+}
+
+TEST_CASE("ops: a board whose allocation table is nonsense gets an error from every reader and writer",
+          "[ops][servo]") {
+  // The trial's tables: every block shifted by one byte, a duplicate, one outside the area.
+  const std::vector<std::vector<std::uint8_t>> tables = {
+      table_of({{0, 0x0091}, {1, 0x00A5}, {2, 0x00B9}}),
+      table_of({{0, 0x0090}, {1, 0x00A4}, {2, 0x00A4}}),
+      table_of({{0, 0x0090}, {1, 0x0500}}),
+  };
+  for (const auto& t : tables) {
+    board_wire w;
+    REQUIRE(w.write_ram(0x0044, t).is_ack());
+    ops::scan_servos scan;
+    run(w, scan);
+    CHECK(scan.error() == errc::bad_allocation_table);
+    CHECK(scan.value().empty());
+    ops::read_servo_states states;
+    run(w, states);
+    CHECK(states.error() == errc::bad_allocation_table);
+    CHECK(states.value().empty());
+    ops::scan_slots probe;
+    run(w, probe);
+    CHECK(probe.error() == errc::bad_allocation_table);
+    const auto before = w.read_word(0x0090 + 6);
+    auto free_all = ops::set_servo_power(ops::power_state::free);
+    const auto sent = run(w, free_all);
+    CHECK(free_all.error() == errc::bad_allocation_table);
+    CHECK(sent.size() == 1);  // the table read only: nothing freed
+    CHECK(w.read_word(0x0090 + 6) == before);
+  }
+}
+
 TEST_CASE("ops: an empty motion slot is refused before anything changes", "[ops][motion]") {
   board_wire w;
   const auto before = w.read_word(0);

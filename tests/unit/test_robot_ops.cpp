@@ -235,6 +235,34 @@ TEST_CASE("robot ops: trims go to RAM +2 and, persistently, to HTH4's servo imag
   CHECK(none.error() == errc::servo_not_allocated);
 }
 
+TEST_CASE("robot ops: a nonsense allocation table moves nothing and writes no trim", "[robot]") {
+  board_wire w;
+  // Every KHR-3HV block shifted by one byte (0x0091 + 20k): odd addresses, refused whole.
+  std::vector<std::uint8_t> table(70, 0xFF);
+  for (unsigned k : {0u, 1u, 2u, 16u, 17u}) {
+    const unsigned a = 0x0091 + 20 * k;
+    table[2 * k] = static_cast<std::uint8_t>(a & 0xFF);
+    table[2 * k + 1] = static_cast<std::uint8_t>(a >> 8);
+  }
+  REQUIRE(w.write_ram(0x0044, table).is_ack());
+  const auto m = arm();
+  locate_joints where(m);
+  run(w, where);
+  CHECK(where.error() == errc::bad_allocation_table);
+
+  const auto trim_before = w.read_word(0x0090 + 20 * 16 + 2);
+  const auto target_before = w.read_word(0x0090 + 20 * 16 + 6);
+  write_trims trims({std::get<joint_trim>(trim_of(*m.find("left_knee"), 2.0))}, true);
+  CHECK(run(w, trims).size() == 1);  // the table read only
+  CHECK(trims.error() == errc::bad_allocation_table);
+  move_joints mv(checked(m, {{"left_knee", 10, {}}}, 100ms));
+  CHECK(run(w, mv).size() == 1);
+  CHECK(mv.error() == errc::bad_allocation_table);
+  w.wait(200ms);
+  CHECK(w.read_word(0x0090 + 20 * 16 + 2) == trim_before);
+  CHECK(w.read_word(0x0090 + 20 * 16 + 6) == target_before);
+}
+
 TEST_CASE("robot ops: a scan tells allocated slots that answer from those that never did", "[robot]") {
   board::options o;
   o.unanswered.insert(ics_number{7});

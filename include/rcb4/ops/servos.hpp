@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <functional>
 #include <limits>
+#include <span>
 #include <vector>
 
 namespace rcb4::ops {
@@ -39,26 +40,45 @@ struct servo_slot {
   friend bool operator==(const servo_slot&, const servo_slot&) = default;
 };
 
+/**
+ * The allocated slots of an ICS allocation table (@p table: its 70 bytes from RAM 0x0044, ICS 0–34,
+ * little-endian words, protocol.md §6), ascending; errc::bad_allocation_table when an entry cannot
+ * be a servo block. 0xFFFF is no servo, and so is 0x0000 (a table of zeros, as on a board without
+ * a project). Any other entry must be a whole 20-byte block inside the user area (0x0090–0x048F,
+ * §6) at an even address (its fields are 16-bit words, §7), and no two blocks may overlap. Blocks
+ * need not sit at HeartToHeart4's 0x0090 + 20·k (§7: read the table, do not assume it), but a
+ * table that breaks these rules would make every reader show made-up angles and every trim write
+ * land in another servo's block, so it is refused whole.
+ */
+inline result<std::vector<servo_slot>> parse_allocation_table(std::span<const std::uint8_t> table) {
+  if (table.size() < 70) return errc::bad_allocation_table;
+  std::vector<servo_slot> slots;
+  for (unsigned k = 0; k < 35; ++k) {
+    const auto a = static_cast<std::uint16_t>(table[2 * k] | (table[2 * k + 1] << 8));
+    if (a == ram::no_allocation || a == 0) continue;
+    if (a < ram::user_area.value() || std::uint32_t{a} + servo_block::size > ram_size || a % 2 != 0)
+      return errc::bad_allocation_table;
+    slots.push_back({ics_number::make(k).value(), a});
+  }
+  std::vector<std::uint16_t> at;
+  for (const auto& s : slots) at.push_back(s.address);
+  std::sort(at.begin(), at.end());
+  for (std::size_t i = 1; i < at.size(); ++i)
+    if (at[i] < at[i - 1] + servo_block::size) return errc::bad_allocation_table;
+  return slots;
+}
+
 namespace detail {
 /** The allocation table read: ICS 0–34, 2 bytes each at 0x0044 (ICS 35 has no entry, §6). */
 inline command read_allocation() { return command{move::read_ram(ram::ics_allocation, 70).value()}; }
 /**
- * The allocated slots in a reply to read_allocation(). An entry is a servo block only inside the
- * user area (0x0090–0x048F, protocol.md §6): 0xFFFF (none), and entries pointing into the
- * system registers (a table of zeros, as on a board without a project) or past RAM, are not
- * servos, so nothing is ever read from the config word or the program counter as a position.
+ * The allocated slots in a reply to read_allocation(), ascending, or errc::bad_allocation_table.
+ * See parse_allocation_table() for what an entry may hold.
  */
-inline std::vector<servo_slot> allocated_slots(const reply& r) {
-  std::vector<servo_slot> slots;
-  for (unsigned k = 0; k < 35; ++k) {
-    const std::uint16_t a = r.u16(2 * k);
-    if (a == ram::no_allocation || a < ram::user_area.value() || std::uint32_t{a} + servo_block::size > ram_size)
-      continue;
-    slots.push_back({ics_number::make(k).value(), a});
-  }
-  return slots;
+inline result<std::vector<servo_slot>> allocated_slots(const reply& r) {
+  if (const auto e = check_reply(r, true, 70); e != errc{}) return e;
+  return parse_allocation_table(r.bytes());
 }
-
 /**
  * RAM reads of byte ranges, as plan_reads chooses them for a link, into a RAM image: the read
  * half of every servo-block reader (read_servo_states, scan_slots, robot::read_joints).
@@ -111,7 +131,8 @@ class scan_servos {
   /** Takes its reply. */
   void on_reply(const reply& r) {
     done_ = true;
-    if ((error_ = detail::check_reply(r, true, 70)) == errc{}) slots_ = detail::allocated_slots(r);
+    auto slots = detail::allocated_slots(r);
+    if ((error_ = slots.error()) == errc{}) slots_ = std::move(slots).value();
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
@@ -147,9 +168,10 @@ class read_servo_states {
   /** Takes a reply. */
   void on_reply(const reply& r) {
     if (!table_read_) {
-      if ((error_ = detail::check_reply(r, true, 70)) != errc{}) return;
+      auto slots = detail::allocated_slots(r);
+      if ((error_ = slots.error()) != errc{}) return;
       std::vector<byte_range> wanted;
-      blocks_ = detail::allocated_slots(r);
+      blocks_ = std::move(slots).value();
       for (const auto& b : blocks_) wanted.push_back({b.address + 2u, 6u});  // trim, position, target
       reads_ = detail::planned_reads(std::move(wanted), cost_);
       table_read_ = true;
@@ -197,9 +219,10 @@ class on_servos {
   }
   void on_reply(const reply& r) {
     if (!have_mask_) {
-      if ((error_ = check_reply(r, true, 70)) != errc{}) return;
+      const auto slots = allocated_slots(r);
+      if ((error_ = slots.error()) != errc{}) return;
       servo_mask all;
-      for (const auto& s : allocated_slots(r)) all.insert(s.ics);
+      for (const auto& s : *slots) all.insert(s.ics);
       use(all);
       return;
     }

@@ -40,9 +40,10 @@ class scan_slots {
   /** Takes a reply. */
   void on_reply(const reply& r) {
     if (!table_read_) {
-      if ((error_ = detail::check_reply(r, true, 70)) != errc{}) return;
+      const auto slots = detail::allocated_slots(r);
+      if ((error_ = slots.error()) != errc{}) return;
       std::vector<byte_range> wanted;
-      for (const auto& s : detail::allocated_slots(r)) {
+      for (const auto& s : *slots) {
         probes_.push_back({s.ics, s.address, 0});
         wanted.push_back({s.address + 4u, 2u});
       }

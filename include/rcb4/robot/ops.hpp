@@ -264,8 +264,9 @@ class move_joints {
   /** Takes a reply. */
   void on_reply(const reply& r) {
     if (step_ == 0) {
-      if ((error_ = ops::detail::check_reply(r, true, 70)) != errc{}) return;
-      const auto slots = ops::detail::allocated_slots(r);
+      const auto table = ops::detail::allocated_slots(r);
+      if ((error_ = table.error()) != errc{}) return;
+      const auto& slots = *table;
       for (const auto& m : moves_)
         if (!detail::slot_of(slots, *m.j)) {
           error_ = errc::servo_not_allocated;
@@ -413,8 +414,9 @@ class write_trims {
   /** Takes a reply. */
   void on_reply(const reply& r) {
     if (step_ == 0) {
-      if ((error_ = ops::detail::check_reply(r, true, 70)) != errc{}) return;
-      const auto slots = ops::detail::allocated_slots(r);
+      const auto table = ops::detail::allocated_slots(r);
+      if ((error_ = table.error()) != errc{}) return;
+      const auto& slots = *table;
       for (const auto& t : trims_) {
         const auto* s = detail::slot_of(slots, *t.j);
         if (!s) {
