@@ -1,5 +1,6 @@
 // rcb4 command-line tool: bench — round trips and the robot's control cycle per second next to the
-// wire limit, and next to iory/rcb4's cycle on the same link.
+// wire limit and the link's limit (wire plus each exchange's measured cost), and next to
+// iory/rcb4's cycle on the same link.
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
@@ -88,6 +89,17 @@ int bench(session& s, const bench_options& o, const globals& g) {
   for (const auto& r : reads.plan()) read_sizes.push_back(static_cast<unsigned>(r.size));
   const auto ping_limit = limit(3 + 4), read_limit = limit(10 + 5), cycle_limit = limit(cycle_bytes),
              iory_limit = limit(iory_bytes);
+  // The link's limit: the bytes at what the link charges for them (its rate, or as measured when
+  // it is not paced at one), plus each exchange's measured cost.
+  const auto link_limit = [&](std::size_t bytes, std::size_t exchanges) {
+    const auto t = cost.byte_time * static_cast<long long>(bytes) + cost.exchange * static_cast<long long>(exchanges);
+    return 1.0 / std::chrono::duration<double>(t).count();
+  };
+  const double cycle_link = link_limit(cycle_bytes, reads.plan().size() + 1), iory_link = link_limit(iory_bytes, 6);
+  // Faster than the wire: the board answers sooner than its bytes could cross a line at this rate.
+  const bool beyond_wire = (ping_limit && ping_rate > *ping_limit * 1.02) ||
+                           (read_limit && read_rate > *read_limit * 1.02) ||
+                           (cycle_limit && cycle_rate > *cycle_limit * 1.02);
   const auto opt = [](std::optional<double> v) { return v ? json(std::round(*v * 10) / 10) : json(nullptr); };
   if (g.json) {
     json j;
@@ -100,13 +112,17 @@ int bench(session& s, const bench_options& o, const globals& g) {
     j["read_wire_limit"] = opt(read_limit);
     j["cycle_hz"] = std::round(cycle_rate * 10) / 10;
     j["cycle_wire_limit_hz"] = opt(cycle_limit);
+    j["cycle_link_limit_hz"] = std::round(cycle_link * 10) / 10;
     j["cycle_bytes"] = cycle_bytes;
     j["servos"] = targets.joints().size();
     j["robot"] = model.name();
     j["plan_reads"] = read_sizes;
     j["exchange_overhead_us"] = std::round(overhead_us * 10) / 10;
+    j["byte_time_ns"] = cost.byte_time.count();
+    j["paced"] = !beyond_wire;
     j["iory_cycle_hz"] = std::round(iory_rate * 10) / 10;
     j["iory_cycle_wire_limit_hz"] = opt(iory_limit);
+    j["iory_cycle_link_limit_hz"] = std::round(iory_link * 10) / 10;
     j["iory_cycle_bytes"] = iory_bytes;
     emit(j);
     return exit_ok;
@@ -114,24 +130,31 @@ int bench(session& s, const bench_options& o, const globals& g) {
   fmt::print("rcb4 bench against {} {}, {} runs each{}\n", s.where(),
              s.rate_known() ? fmt::format("at {} baud", s.baud()) : std::string("(line rate unknown: give --baud)"),
              o.count, low ? ", CPU wake-up latency held at 0 us" : "");
-  const auto row = [](std::string_view what, double got, std::optional<double> lim, std::string_view unit) {
-    if (lim)
-      fmt::print("  {:<46} {:>9.1f} {:<3} wire limit {:>9.1f} {:<3} {:.2f}x\n", what, got, unit, *lim, unit,
-                 got / *lim);
-    else
-      fmt::print("  {:<46} {:>9.1f} {}\n", what, got, unit);
+  const auto row = [](std::string_view what, double got, std::optional<double> lim, std::string_view unit,
+                      std::optional<double> link = std::nullopt) {
+    std::string line = fmt::format("  {:<46} {:>9.1f} {:<3}", what, got, unit);
+    if (lim) line += fmt::format(" wire limit {:>9.1f} ({:.2f}x)", *lim, got / *lim);
+    if (link) line += fmt::format("  link limit {:>8.1f} ({:.2f}x)", *link, got / *link);
+    fmt::print("{}\n", line);
   };
   row("ping", ping_rate, ping_limit, "/s");
   row("MOV read 2 bytes", read_rate, read_limit, "/s");
   row(fmt::format("{} cycle ({} joints, {} B)", model.name(), targets.joints().size(), cycle_bytes), cycle_rate,
-      cycle_limit, "Hz");
-  row(fmt::format("iory/rcb4 cycle (5 x MOV 126 + CONST35, {} B)", iory_bytes), iory_rate, iory_limit, "Hz");
+      cycle_limit, "Hz", cycle_link);
+  row(fmt::format("iory/rcb4 cycle (5 x MOV 126 + CONST35, {} B)", iory_bytes), iory_rate, iory_limit, "Hz", iory_link);
   fmt::print("  {} cycle / iory/rcb4 cycle: {:.2f}x\n", model.name(), cycle_rate / iory_rate);
   fmt::print(
-      "  link measured at {:.0f} us per exchange beyond the wire: the planner reads the joints in {} ({} bytes)\n",
-      overhead_us, plural(read_sizes.size(), "read"), fmt::join(read_sizes, "+"));
-  if (s.is_virtual())
-    fmt::print("  (the in-process virtual board is not paced: it can beat the wire limit; use rcb4 serve --pace)\n");
+      "  link measured at {:.0f} us per exchange beyond the wire, {:.2f} us a byte: the planner reads the "
+      "joints in {} ({} bytes)\n",
+      overhead_us, std::chrono::duration<double, std::micro>(cost.byte_time).count(), plural(read_sizes.size(), "read"),
+      fmt::join(read_sizes, "+"));
+  fmt::print("  (link limit: the bytes plus each exchange's measured cost{})\n",
+             s.rate_known() ? "; the wire limit counts the bytes only" : "");
+  if (beyond_wire)
+    fmt::print(
+        "  warning: faster than {} baud carries the bytes: this board is not paced at that rate (a virtual "
+        "board, a pty, a bridge that buffers), so these figures say nothing of a real line{}\n",
+        s.baud(), s.is_virtual() ? "; rcb4 serve --pace paces one" : "");
   return exit_ok;
 }
 

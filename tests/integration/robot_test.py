@@ -171,6 +171,20 @@ with serve("--pace", "--latency", "1000") as dev:
     check(b.get("plan_reads") == [122, 42, 122, 42] and b["cycle_bytes"] == 4 * 13 + 328 + 49 + 4,
           f"and reads the 20 positions in 4 reads ({b.get('plan_reads')}, {b.get('cycle_bytes')} bytes)")
     check(b.get("iory_cycle_bytes") == 5 * (10 + 129) + 79 + 4, "next to iory/rcb4's 5 x MOV 126 + CONST35 (ICS 35 is the receiver's)")
+    check(b.get("paced") is True and b.get("byte_time_ns") == 8800 and 0.7 <= b["cycle_hz"] / b["cycle_link_limit_hz"] <= 1.1,
+          f"on a paced link the cycle runs near the link's limit, bytes at 1.25 Mbaud ({b.get('cycle_hz')} of {b.get('cycle_link_limit_hz')} Hz)")
+    rc, out, err = run("--device", dev, "--baud", "1250000", "bench", "--count", "5")
+    check(rc == 0 and "link limit" in out and "warning" not in out, "its text shows the link limit, without a warning")
+
+# A board that is not paced answers faster than the wire: the bench says so, and the planner still
+# merges (the link charges per exchange, hardly per byte) instead of planning 20 reads.
+with serve() as dev:
+    rc, out, err = run("--json", "--device", dev, "--baud", "1250000", "bench", "--count", "10")
+    b = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and b.get("paced") is False and len(b.get("plan_reads", [])) <= 4,
+          f"bench against an unpaced board: paced false, {len(b.get('plan_reads', []))} reads")
+    rc, out, err = run("--device", dev, "--baud", "1250000", "bench", "--count", "10")
+    check(rc == 0 and "warning: faster than 1250000 baud carries the bytes" in out, "and its text warns")
 
 # Profiles: the shipped files, another robot, bad files.
 rc, out, err = run("--robot", os.path.join(PROFILES, "kxr-l2.yaml"), "joint", "list")

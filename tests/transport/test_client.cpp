@@ -215,6 +215,24 @@ TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per 
   CHECK(ec);
 }
 
+TEST_CASE("measure_link: a board that is not paced is measured as it is, not as its baud", "[transport][pace]") {
+  served_board b;  // no --pace: replies come as fast as the pty carries them, at any baud
+  t::io_thread io;
+  auto c = open_client(io, b.server->where());
+  c.options().baud = 1250000;
+  t::error_code ec;
+  const auto cost = t::measure_link(c, ec, 5);
+  REQUIRE_FALSE(ec);
+  // 126 more bytes took less than half their 1.1 ms at 1.25 Mbaud: the bytes cost what was measured.
+  CHECK(cost.byte_time < 4400ns);
+  CHECK(cost.exchange > 0ns);  // an exchange still costs something: the round trip through the pty
+  // So the planner merges, as it should on such a link (a read costs little more for more bytes),
+  // instead of planning 20 reads for a rate the link does not have.
+  std::vector<ops::byte_range> positions;
+  for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
+  CHECK(ops::plan_reads(positions, cost).size() == 3);
+}
+
 TEST_CASE("client: callback, future, coroutine and deferred completions", "[transport]") {
   served_board b;
   t::io_thread io;

@@ -106,28 +106,43 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps) {
 }
 
 /**
- * Measures what one exchange costs on @p c beyond its bytes' time on the wire: adapter latency,
- * the board's turnaround, the operating system. Times @p samples 2-byte reads of the config word
- * (10 bytes out, 5 back), takes the median and subtracts those 15 bytes' wire time at the
- * client's rate (options().baud). The result is the read planner's cost of this link
- * (ops::plan_reads, protocol.md §4): on a fast link it reads joints one by one, behind a
- * millisecond of USB latency it merges them into long reads. Sets @p ec if an exchange fails.
+ * Measures what a read costs on @p c: the planner's link_cost (ops::plan_reads, protocol.md §4).
+ * Times @p samples 2-byte and @p samples 128-byte reads of RAM and takes the medians. The
+ * exchange cost is what a read takes beyond its bytes' time on the wire (adapter latency, the
+ * board's turnaround, the operating system): on a fast link the planner then reads joints one by
+ * one, behind a millisecond of USB latency it merges them into long reads.
+ * The bytes cost the client's rate (options().baud, 11 bits a byte) as long as the 126 extra bytes
+ * of the long read take at least half their wire time. When they take less, the line is not paced
+ * at that rate (a pty, a board in process, a bridge that buffers): the cost is then the measured
+ * time per byte and the rest of the short read, so plans fit the link as it is instead of a rate
+ * it does not have. Sets @p ec if an exchange fails.
  */
 template <AsyncByteStream Stream>
 ops::link_cost measure_link(basic_client<Stream>& c, error_code& ec, int samples = 9) {
-  const command read = move::read_ram(ram::config, 2).value();
-  std::vector<std::chrono::nanoseconds> times;
-  c.execute(read, ec);  // the first exchange may pay for a cold path; it is not counted
-  for (int i = 0; i < samples && !ec; ++i) {
-    const auto t0 = std::chrono::steady_clock::now();
-    c.execute(read, ec);
-    times.push_back(std::chrono::steady_clock::now() - t0);
-  }
-  if (ec || times.empty()) return {};
-  std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+  const command short_read = move::read_ram(ram::config, 2).value();
+  const command long_read = move::read_ram(ram::user_area, 128).value();
+  const auto median_of = [&](const command& read) {
+    std::vector<std::chrono::nanoseconds> times;
+    for (int i = 0; i < samples && !ec; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      c.execute(read, ec);
+      times.push_back(std::chrono::steady_clock::now() - t0);
+    }
+    if (ec || times.empty()) return std::chrono::nanoseconds{0};
+    std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+    return times[times.size() / 2];
+  };
+  c.execute(short_read, ec);  // the first exchange may pay for a cold path; it is not counted
+  if (ec) return {};
+  const auto t_short = median_of(short_read);
+  const auto t_long = median_of(long_read);
+  if (ec || samples <= 0) return {};
   const auto baud = c.options().baud > 0 ? c.options().baud : 115200u;
-  const auto overhead = times[times.size() / 2] - wire_time(15, baud);
-  return ops::link_cost::at(baud, std::max(overhead, std::chrono::nanoseconds(0)));
+  auto cost = ops::link_cost::at(baud, {});
+  const auto per_byte = std::max(t_long - t_short, std::chrono::nanoseconds(0)) / 126;
+  if (per_byte * 2 < cost.byte_time) cost.byte_time = per_byte;  // not paced at its rate
+  cost.exchange = std::max(t_short - cost.byte_time * 15, std::chrono::nanoseconds(0));
+  return cost;
 }
 
 /** measure_link that throws system_error. */
