@@ -1,5 +1,5 @@
 # ctest -P script: installs the build tree into a scratch prefix, then builds and runs a consumer
-# with find_package(rcb4), compiles one through pkg-config, checks the installed tool and udev rule,
+# with find_package(rcb4) from the install and from the build tree, compiles one through pkg-config, checks the installed tool and udev rule,
 # and builds a consumer that vendors rcb4 with add_subdirectory.
 file(REMOVE_RECURSE ${WORK})
 execute_process(COMMAND ${CMAKE_COMMAND} --install ${BUILD} --prefix ${WORK}/prefix RESULT_VARIABLE rc OUTPUT_QUIET)
@@ -25,6 +25,8 @@ function(consumer label source build)
 endfunction()
 
 consumer("find_package(rcb4)" ${SOURCE} ${WORK}/build -DCMAKE_PREFIX_PATH=${WORK}/prefix)
+# The build tree as the package, without an install (rcb4_DIR pointing at it).
+consumer("rcb4_DIR=the build tree" ${SOURCE} ${WORK}/build-tree -Drcb4_DIR=${BUILD})
 find_program(PKG_CONFIG pkg-config REQUIRED)
 execute_process(COMMAND ${CMAKE_COMMAND} -E env PKG_CONFIG_PATH=${WORK}/prefix/share/pkgconfig
                         ${PKG_CONFIG} --cflags rcb4 OUTPUT_VARIABLE cflags OUTPUT_STRIP_TRAILING_WHITESPACE RESULT_VARIABLE rc)

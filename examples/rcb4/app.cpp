@@ -287,6 +287,10 @@ failure explain(const std::error_code& ec, std::string_view what) {
     return {exit_timeout, std::string(what),
             "is the board powered, the cable in, the adapter in RCB-4 mode? try --baud; a slow link (a bridge, "
             "a busy adapter) needs a longer --timeout MS; `rcb4 doctor` checks the rest"};
+  if (ec == t::transport_errc::truncated)
+    return {exit_board, std::string(what),
+            "a board answered but its reply stopped short: a noisy or failing line, a wrong baud, or a board "
+            "busy with something else"};
   if (ec == t::transport_errc::port_busy)
     return {exit_io, std::string(what), "another program has the port open (`fuser -v` on the device shows which)"};
   if (ec == std::errc::permission_denied)

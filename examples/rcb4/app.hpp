@@ -29,11 +29,12 @@
 namespace cli {
 
 // Exit codes, one per kind of failure (in `rcb4 --help` and the README).
-inline constexpr int exit_ok = 0;       ///< done
-inline constexpr int exit_board = 1;    ///< the board refused (NACK) or answered something malformed
-inline constexpr int exit_usage = 2;    ///< bad command line
-inline constexpr int exit_io = 3;       ///< device missing, busy, not permitted, unplugged
-inline constexpr int exit_timeout = 4;  ///< no answer before the deadline (silent board, wrong baud)
+inline constexpr int exit_ok = 0;             ///< done
+inline constexpr int exit_board = 1;          ///< the board refused (NACK) or answered something malformed
+inline constexpr int exit_usage = 2;          ///< bad command line
+inline constexpr int exit_io = 3;             ///< device missing, busy, not permitted, unplugged
+inline constexpr int exit_timeout = 4;        ///< no answer before the deadline (silent board, wrong baud)
+inline constexpr int exit_interrupted = 130;  ///< stopped by SIGINT/SIGTERM where the command cleans up first
 
 /** A failure a command reports itself: its message, exit code and a hint with the fix. */
 struct failure : std::runtime_error {

@@ -68,7 +68,7 @@ int bench(session& s, const bench_options& o, const globals& g) {
     reads.restart();
     rcb4::transport::error_code ec;
     rcb4::transport::run(s.c(), reads, ec);
-    if (ec) throw rcb4::transport::system_error(ec, "joint read");
+    if (ec) throw rcb4::transport::system_error(ec);
     s.c().execute(hold_all);
   });
   // iory/rcb4's scheme on the same link: the servo area in five 126-byte reads, then CONST36 of

@@ -56,7 +56,7 @@ int version(session& s, const globals& g) {
   rcb4::ops::read_version op;
   rcb4::transport::error_code ec;
   rcb4::transport::run(s.c(), op, ec);
-  if (ec) throw rcb4::transport::system_error(ec, "version");
+  if (ec) throw rcb4::transport::system_error(ec);
   const auto& v = op.value();
   if (g.json) {
     json j;

@@ -70,7 +70,7 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options
                               last->motion ? fmt::format("motion {}", *last->motion) : std::string("a program"),
                               seconds(), last->program_counter),
                   "wait longer (--timeout S), or stop it: rcb4 motion stop");
-  if (ec) throw rcb4::transport::system_error(ec, "motion wait");
+  if (ec) throw rcb4::transport::system_error(ec);
   return {seconds(), st};
 }
 
@@ -177,7 +177,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     rcb4::transport::error_code ec;
     s.run_steps(op, ec, [&] { bar.update(op.slots_done()); });
     bar.finish();
-    if (ec) throw rcb4::transport::system_error(ec, "motion list");
+    if (ec) throw rcb4::transport::system_error(ec);
     json arr = json::array();
     if (!ctx.g.json) fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {}\n", "slot", "name", "address", "bytes", "frames");
     for (const auto& v : op.value()) {

@@ -3,10 +3,14 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <thread>
+
+#include <unistd.h>
 
 namespace cli {
 namespace {
@@ -14,9 +18,61 @@ namespace {
 using namespace std::chrono_literals;
 namespace robot = rcb4::robot;
 
-json rounded(std::optional<double> d) { return d ? json(std::round(*d * 100) / 100) : json(nullptr); }
+/** Degrees to a hundredth for JSON, without -0; null for none. */
+json rounded(std::optional<double> d) {
+  if (!d) return nullptr;
+  const double r = std::round(*d * 100) / 100;
+  return r == 0 ? 0.0 : r;
+}
 
-std::string deg_text(std::optional<double> d) { return d ? fmt::format("{:+.1f}", *d) : std::string("-"); }
+volatile std::sig_atomic_t signalled = 0;
+extern "C" void on_capture_signal(int) { signalled = 1; }
+
+bool interrupted_by_signal() { return signalled != 0; }
+
+/**
+ * Catches SIGINT and SIGTERM while it lives (without SA_RESTART, so a blocking read returns), so
+ * that a command can undo what it did (hold the joints it freed) before it exits.
+ */
+class signal_catcher {
+ public:
+  signal_catcher() {
+    struct sigaction act {};
+    act.sa_handler = on_capture_signal;
+    sigemptyset(&act.sa_mask);
+    act.sa_flags = 0;
+    ::sigaction(SIGINT, &act, &old_int_);
+    ::sigaction(SIGTERM, &act, &old_term_);
+  }
+  ~signal_catcher() {
+    ::sigaction(SIGINT, &old_int_, nullptr);
+    ::sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  signal_catcher(const signal_catcher&) = delete;
+  signal_catcher& operator=(const signal_catcher&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+/** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
+bool wait_for_enter() {
+  for (char c = 0; !signalled;) {
+    const auto n = ::read(STDIN_FILENO, &c, 1);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    if (c == '\n') return !signalled;
+  }
+  return false;
+}
+
+/** Degrees to a tenth, signed, without "-0.0"; "-" for none. */
+std::string deg_text(std::optional<double> d) {
+  if (!d) return "-";
+  const double tenths = std::round(*d * 10) / 10;
+  return fmt::format("{:+.1f}", tenths == 0 ? 0.0 : tenths);
+}
 
 /** The joints the words name (joints, groups, "all"; none: all), each once, in the model's order. */
 std::vector<const robot::joint*> joints_of(const robot::model& m, const std::vector<std::string>& words) {
@@ -61,19 +117,30 @@ std::vector<robot::joint_move> checked(const robot::model& m, const std::vector<
   return std::get<std::vector<robot::joint_move>>(std::move(r));
 }
 
+/** Moves sent, and the board's output period that times them. */
+struct sent_moves {
+  std::vector<robot::joint_move> moves;
+  long long period_ms = 10;
+};
+
 /** Sends checked moves; with @p wait, polls until every moved joint's output reached its target. */
-std::vector<robot::joint_move> move(session& s, const robot::model& m, std::vector<robot::joint_move> moves,
-                                    bool wait) {
+sent_moves move(session& s, const robot::model& m, std::vector<robot::joint_move> moves, bool wait) {
   std::vector<const robot::joint*> need;
   for (const auto& mv : moves) need.push_back(mv.j);
   const auto map = locate(s, m, need);
+  // A running ROM motion writes the outputs every frame: a move now would be overwritten at once.
+  if (const auto state = s.run(rcb4::ops::read_motion_state{}); state.running)
+    throw failure(exit_board,
+                  fmt::format("{} is running on the board: it would overwrite the move, so nothing was sent",
+                              state.motion ? fmt::format("motion {}", *state.motion) : std::string("a ROM program")),
+                  "rcb4 motion wait lets it finish; rcb4 motion stop suspends it");
   robot::move_joints op(std::move(moves));
   rcb4::transport::error_code ec;
   s.run_steps(op, ec, [] {});
   if (ec == rcb4::errc::frames_out_of_range)
     throw usage_error(fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period",
                                   255 * milliseconds(op.period()), milliseconds(op.period())));
-  if (ec) throw rcb4::transport::system_error(ec, "joint move");
+  if (ec) throw rcb4::transport::system_error(ec);
   auto done = op.value();
   if (wait) {
     // The board's output reaches the target when its interpolation ends (+6 = the CONST's position).
@@ -95,24 +162,30 @@ std::vector<robot::joint_move> move(session& s, const robot::model& m, std::vect
       std::this_thread::sleep_for(std::chrono::milliseconds(milliseconds(op.period())));
     }
   }
-  return done;
+  return {std::move(done), static_cast<long long>(milliseconds(op.period()))};
 }
 
-void print_moves(const std::vector<robot::joint_move>& done, const globals& g, std::string_view verb) {
+/** One line (or JSON object) per joint moved: its angle, position, and the time it takes in frames. */
+void print_moves(const sent_moves& sent, const globals& g, std::string_view verb) {
   if (g.json) {
     json list = json::array();
-    for (const auto& mv : done)
+    for (const auto& mv : sent.moves)
       list.push_back({{"name", mv.j->name},
                       {"degrees", mv.degrees},
                       {"position", mv.position.value()},
                       {"frames", mv.frames},
-                      {"ms", mv.time.count()}});
+                      {"ms", mv.frames * sent.period_ms},
+                      {"asked_ms", mv.time.count()}});
     emit(json{{verb, list}});
     return;
   }
-  for (const auto& mv : done)
-    fmt::print("{} {} to {:+.1f} deg (position {}) over {} ms ({} frames)\n", verb, mv.j->name, mv.degrees,
-               mv.position.value(), mv.time.count(), mv.frames);
+  for (const auto& mv : sent.moves) {
+    // The board moves in whole output periods: a time between two is rounded to the nearest.
+    const long long ms = mv.frames * sent.period_ms;
+    fmt::print("{} {} to {} deg (position {}) over {} ms ({} of {} ms{})\n", verb, mv.j->name, deg_text(mv.degrees),
+               mv.position.value(), ms, plural(mv.frames, "frame"), sent.period_ms,
+               ms != mv.time.count() ? fmt::format("; {} ms asked", mv.time.count()) : std::string());
+  }
 }
 
 /** NAME=DEG[@MS] items. */
@@ -139,9 +212,22 @@ std::vector<robot::joint_target> targets_of(const std::vector<std::string>& item
   return out;
 }
 
-/** The pose file @p path for @p m; a bad one is a usage error with its file:line. */
+/** A usage error unless @p path names a pose file by its extension (or is -, stdin/stdout). */
+void check_pose_name(const std::string& path) {
+  if (path == "-") return;
+  const auto ext = std::filesystem::path(path).extension();
+  if (ext != ".json" && ext != ".yaml" && ext != ".yml")
+    throw usage_error(fmt::format("{}: a pose file ends in .json, .yaml or .yml (- for stdin/stdout)", path));
+}
+
+/** The pose file @p path (- : stdin) for @p m; a bad one is a usage error with its file:line. */
 robot::pose pose_of(const std::string& path, const robot::model& m) {
+  check_pose_name(path);
   try {
+    if (path == "-") {
+      const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+      return robot::parse_pose(text, "<stdin>", m);
+    }
     return robot::load_pose(path, m);
   } catch (const robot::profile_error& e) {
     throw usage_error(e.what());
@@ -162,7 +248,7 @@ void print_joints(const robot::model& m, const std::vector<robot::joint_reading>
       j["target"] = rounded(r.target_degrees());
       j["state"] = !r.allocated ? "unallocated" : r.is_free() ? "free" : r.is_hold() ? "hold" : "position";
       j["position"] = r.allocated ? json(r.position) : json(nullptr);
-      j["trim"] = r.allocated ? json(std::round(robot::trim_degrees(*r.j, r.trim) * 100) / 100) : json(nullptr);
+      j["trim"] = r.allocated ? rounded(robot::trim_degrees(*r.j, r.trim)) : json(nullptr);
       j["lower"] = r.j->lower;
       j["upper"] = r.j->upper;
       list.push_back(j);
@@ -170,7 +256,7 @@ void print_joints(const robot::model& m, const std::vector<robot::joint_reading>
     emit(list);
     return;
   }
-  fmt::print("{} ({} joints)\n", m.name(), rs.size());
+  fmt::print("{} ({})\n", m.name(), plural(rs.size(), "joint"));
   fmt::print("{:<22} {:>4} {:>6}  {:>8}  {:>8}  {:>6}  {}\n", "joint", "ICS", "ID/bus", "degrees", "target", "trim",
              "limits");
   for (const auto& r : rs) {
@@ -180,7 +266,7 @@ void print_joints(const robot::model& m, const std::vector<robot::joint_reading>
                                              : deg_text(r.target_degrees());
     fmt::print("{:<22} {:>4} {:>4}/{}  {:>8}  {:>8}  {:>6}  {:g}..{:g}\n", r.j->name, r.j->ics.value(), r.j->servo_id(),
                r.j->bus(), deg_text(r.degrees()), target,
-               r.allocated ? fmt::format("{:+.1f}", robot::trim_degrees(*r.j, r.trim)) : "-", r.j->lower, r.j->upper);
+               r.allocated ? deg_text(robot::trim_degrees(*r.j, r.trim)) : "-", r.j->lower, r.j->upper);
   }
 }
 
@@ -267,18 +353,19 @@ void add_pose(CLI::App& app, context& ctx) {
     std::string file;
     std::vector<std::string> joints;
     bool free = false;
+    bool force = false;
   };
   auto co = std::make_shared<capture_options>();
   capture->add_option("FILE", co->file, "pose file: .json, .yaml or .yml; - for JSON on stdout")->required();
   capture->add_option("--joints", co->joints, "joints or groups to capture (default: all)");
   capture->add_flag("--free", co->free,
-                    "free the joints first, wait for Enter while you pose the robot by hand, then capture and hold");
+                    "free the joints first, wait for Enter while you pose the robot by hand, then capture and hold "
+                    "(Ctrl-C or the end of stdin: hold them again, capture nothing)");
+  capture->add_flag("--force", co->force, "replace FILE if it exists");
   capture->callback([&ctx, co] {
-    if (co->file != "-") {
-      const auto ext = std::filesystem::path(co->file).extension();
-      if (ext != ".json" && ext != ".yaml" && ext != ".yml")
-        throw usage_error(fmt::format("{}: a pose file ends in .json, .yaml or .yml", co->file));
-    }
+    check_pose_name(co->file);
+    if (co->file != "-" && !co->force && std::filesystem::exists(co->file))
+      throw usage_error(fmt::format("{} exists: --force replaces it", co->file));
     ctx.action = [&ctx, co] {
       const auto& m = robot_of(ctx.g);
       const auto js = joints_of(m, co->joints);
@@ -286,11 +373,21 @@ void add_pose(CLI::App& app, context& ctx) {
       const auto map = locate(s, m, js);
       rcb4::servo_mask mask;
       for (const auto* j : js) mask.insert(j->ics);
+      std::optional<signal_catcher> catcher;  // from before the joints go free until they hold again
       if (co->free) {
+        catcher.emplace();
         s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::free, mask));
-        fmt::print(stderr, "{} free: pose the robot by hand, then press Enter\n", plural(js.size(), "joint"));
-        std::string line;
-        std::getline(std::cin, line);
+        fmt::print(stderr, "{} free: pose the robot by hand, then press Enter (Ctrl-C: hold them, capture nothing)\n",
+                   plural(js.size(), "joint"));
+        if (!wait_for_enter()) {
+          s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
+          if (interrupted_by_signal())
+            throw failure(exit_interrupted,
+                          "interrupted before Enter: nothing captured; the joints hold where they are");
+          throw usage_error(
+              "stdin ended before Enter: nothing captured; the joints hold where they are (--free waits "
+              "for Enter on a terminal)");
+        }
       }
       const auto rs = read_all(s, map, robot::fields::positions);
       robot::pose p{m.name(), {}, std::nullopt};
@@ -429,7 +526,21 @@ void add_trim(CLI::App& app, context& ctx) {
         trims.push_back(std::get<robot::joint_trim>(tr));
       }
       session s(ctx.g);
-      const auto done = s.run(robot::write_trims(trims, so->persist));
+      robot::write_trims op(trims, so->persist);
+      rcb4::transport::error_code ec;
+      s.run_steps(op, ec, [] {});
+      if (ec && op.written() > 0) {
+        // Some writes landed before the failure: say which, so nobody believes nothing changed.
+        const std::size_t per = so->persist ? 2 : 1;
+        std::vector<std::string> ram, rom;
+        for (std::size_t i = 0; i < op.written(); ++i)
+          (i % per == 0 ? ram : rom).push_back(fmt::format("{} {:+d}", trims[i / per].j->name, trims[i / per].counts));
+        const std::string rom_done = rom.empty() ? std::string("none") : fmt::format("{}", fmt::join(rom, ", "));
+        throw explain(ec, fmt::format("{} (already written: RAM {}{})", ec.message(), fmt::join(ram, ", "),
+                                      so->persist ? "; ROM " + rom_done : std::string()));
+      }
+      if (ec) throw rcb4::transport::system_error(ec);
+      const auto& done = op.value();
       json list = json::array();
       for (const auto& t : done) {
         if (ctx.g.json)

@@ -81,14 +81,15 @@ std::vector<rcb4::ops::servo_state> states_of(session& s) {
   return states;
 }
 
-/** Refuses (usage, nothing sent) servos the board has no block for: the board would ignore them. */
+/** Refuses (exit 1, nothing sent) servos the board has no block for: the board would ignore them. */
 void require_allocated(session& s, const std::optional<rcb4::servo_mask>& m) {
   const auto slots = s.run(rcb4::ops::scan_servos{});
   if (slots.empty()) no_servos();
   if (!m) return;
   for (auto n : *m)
     if (std::none_of(slots.begin(), slots.end(), [&](const auto& slot) { return slot.ics == n; }))
-      throw usage_error(fmt::format("ICS {} has no servo allocated (see rcb4 servo list)", n.value()));
+      throw failure(exit_board, fmt::format("ICS {} has no servo allocated", n.value()),
+                    "rcb4 servo list shows the allocated slots");
 }
 
 json ics_list(const rcb4::servo_mask& done) {
@@ -157,7 +158,8 @@ void add_servo_commands(CLI::App& app, context& ctx) {
       auto states = states_of(s);
       for (auto n : want)
         if (std::none_of(states.begin(), states.end(), [&](const auto& st) { return st.ics == n; }))
-          throw usage_error(fmt::format("ICS {} has no servo allocated (see rcb4 servo list)", n.value()));
+          throw failure(exit_board, fmt::format("ICS {} has no servo allocated", n.value()),
+                        "rcb4 servo list shows the allocated slots");
       std::erase_if(states, [&](const auto& st) { return !want.contains(st.ics); });
       print_states(states, ctx.g);
       return exit_ok;

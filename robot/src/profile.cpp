@@ -30,6 +30,8 @@ std::string scalar(const std::string& source, const YAML::Node& n, const std::st
 
 double number(const std::string& source, const YAML::Node& n, const std::string& what) {
   const std::string s = scalar(source, n, what);
+  // A quoted scalar ("10") is a string, in YAML and in JSON: a number is written bare.
+  if (n.Tag() == "!") fail(source, n, what + ": expected a number, not the string \"" + s + "\"");
   try {
     std::size_t used = 0;
     const double v = std::stod(s, &used);
@@ -201,7 +203,13 @@ pose parse_pose_nodes(std::string_view text, const std::string& source, const mo
   if (!root.IsMap()) throw profile_error(source, "a pose is a mapping with robot, joints and optionally time_ms");
   check_keys(source, root, {"robot", "joints", "time_ms"}, "pose");
   pose p;
-  if (root["robot"]) p.robot = scalar(source, root["robot"], "robot");
+  if (root["robot"]) {
+    p.robot = scalar(source, root["robot"], "robot");
+    // Another robot's pose may name the same joints with other zeros, directions and limits.
+    if (p.robot != m.name())
+      fail(source, root["robot"],
+           "this pose is " + p.robot + "'s, not " + m.name() + "'s (--robot names the profile it was captured with)");
+  }
   if (root["time_ms"]) p.time = std::chrono::milliseconds(integer(source, root["time_ms"], "time_ms", 0, 6375));
   const YAML::Node js = root["joints"];
   if (!js || !js.IsMap() || js.size() == 0)
@@ -221,12 +229,20 @@ pose load_pose(const std::filesystem::path& path, const model& m) {
   return parse_pose(read_file(path), path.string(), m);
 }
 
+namespace {
+/** @p d rounded to hundredths of a degree, with no negative zero. */
+double hundredths(double d) {
+  const double r = std::round(d * 100) / 100;
+  return r == 0 ? 0.0 : r;
+}
+}  // namespace
+
 std::string pose_json(const pose& p) {
   nlohmann::ordered_json j;
   j["robot"] = p.robot;
   if (p.time) j["time_ms"] = p.time->count();
   nlohmann::ordered_json joints = nlohmann::ordered_json::object();
-  for (const auto& [n, d] : p.joints) joints[n] = std::round(d * 100) / 100;
+  for (const auto& [n, d] : p.joints) joints[n] = hundredths(d);
   j["joints"] = joints;
   // A robot name read from a file may be any bytes: invalid UTF-8 becomes U+FFFD (found by fuzzing).
   return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
@@ -237,7 +253,9 @@ std::string pose_yaml(const pose& p) {
   out << YAML::BeginMap << YAML::Key << "robot" << YAML::Value << p.robot;
   if (p.time) out << YAML::Key << "time_ms" << YAML::Value << p.time->count();
   out << YAML::Key << "joints" << YAML::Value << YAML::BeginMap;
-  for (const auto& [n, d] : p.joints) out << YAML::Key << n << YAML::Value << std::round(d * 100) / 100;
+  // Six significant digits: ±360.00 at most, written as 39.99, not 39.990000000000002.
+  out.SetDoublePrecision(6);
+  for (const auto& [n, d] : p.joints) out << YAML::Key << n << YAML::Value << hundredths(d);
   out << YAML::EndMap << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }

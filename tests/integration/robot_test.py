@@ -6,12 +6,15 @@
 import contextlib
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 RCB4 = sys.argv[1]
 PROFILES = sys.argv[2]
+README_JOINTS = sys.argv[3] if len(sys.argv) > 3 else None  # the README's joints.cpp, built
 from checks import check, finish
 
 
@@ -109,6 +112,61 @@ with serve() as dev:
     rc, out, err = run(*on, "trim", "set", "left_knee=45")
     check(rc == 2 and "within ±30 degrees" in err, "a trim beyond 30 degrees: exit 2")
 
+    # Pose files as people handle them: stdin, overwriting, another robot's pose, quoted numbers.
+    with tempfile.TemporaryDirectory() as tmp:
+        rc, out, err = run(*on, "pose", "play", "-", "--time", "100", stdin='{"joints": {"head_yaw": 10}}')
+        check(rc == 0 and "head_yaw to +10.0 deg" in out, f"pose play - reads the pose from stdin ({rc}, {err.strip()!r})")
+        rc, out, err = run("pose", "show", "-", stdin="joints:\n  head_yaw: 10\n")
+        check(rc == 0 and "head_yaw" in out, "pose show - too (YAML)")
+        kept = os.path.join(tmp, "kept.yaml")
+        rc, out, err = run(*on, "pose", "capture", kept)
+        text = open(kept).read() if rc == 0 else ""
+        check(rc == 0 and "0000000" not in text and "-0" not in text.replace("-0.", "x"),
+              f"a YAML capture has hundredths, not float noise or -0 ({text[:120]!r})")
+        rc, out, err = run(*on, "pose", "capture", kept)
+        check(rc == 2 and "exists: --force replaces it" in err and open(kept).read() == text,
+              f"capture onto an existing file: exit 2, the file kept ({err.strip()!r})")
+        rc, out, err = run(*on, "pose", "capture", kept, "--force")
+        check(rc == 0, "capture --force replaces it")
+        for name, body in [("x.pose", '{"joints": {"head_yaw": 1}}')]:
+            path = os.path.join(tmp, name)
+            open(path, "w").write(body)
+            rc, out, err = run("pose", "show", path)
+            check(rc == 2 and ".json, .yaml or .yml" in err, f"pose show {name}: exit 2, as capture refuses it")
+        other = os.path.join(tmp, "kxr.json")
+        open(other, "w").write('{"robot": "KXR-L2", "joints": {"head_yaw": 10}}')
+        rc, out, err = run(*on, "pose", "play", other)
+        check(rc == 2 and "this pose is KXR-L2's, not KHR-3HV's" in err, f"another robot's pose: exit 2 ({err.strip()!r})")
+        open(other, "w").write('{"joints": {"head_yaw": "10"}}')
+        rc, out, err = run(*on, "pose", "play", other)
+        check(rc == 2 and 'not the string "10"' in err, "a quoted angle: exit 2")
+
+        # capture --free: the end of stdin or Ctrl-C captures nothing and holds the joints again.
+        rc, out, err = run(*on, "pose", "capture", os.path.join(tmp, "eof.json"), "--free", "--joints", "left_arm", stdin="")
+        check(rc == 2 and "stdin ended before Enter: nothing captured" in err and not os.path.exists(os.path.join(tmp, "eof.json"))
+              and joints()["left_elbow_pitch"]["state"] == "hold", f"capture --free at the end of stdin: exit 2, joints held ({err.strip()!r})")
+        p = subprocess.Popen([RCB4, *on, "pose", "capture", os.path.join(tmp, "int.json"), "--free", "--joints", "left_arm"],
+                             stdin=subprocess.PIPE, stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        prompt = p.stderr.readline()  # the joints are free now (the tool holds the port: no one else can look)
+        p.send_signal(signal.SIGINT)
+        _, err = p.communicate(timeout=30)
+        check(p.returncode == 130 and "4 joints free" in prompt and "interrupted before Enter" in err
+              and joints()["left_elbow_pitch"]["state"] == "hold", f"capture --free, Ctrl-C: exit 130, joints held again ({p.returncode}, {err.strip()!r})")
+
+    # Messages: the time a move really takes, one prefix.
+    rc, out, err = run(*on, "joint", "move", "head_yaw=1@1")
+    check(rc == 0 and "over 10 ms (1 frame of 10 ms; 1 ms asked)" in out, f"a move of 1 ms takes one 10 ms frame, and says so ({out.strip()!r})")
+
+    # A running ROM motion would overwrite a move: refused, nothing sent.
+    rc, out, err = run(*on, "motion", "play", "2")
+    assert rc == 0, err
+    rc, out, err = run(*on, "joint", "move", "head_yaw=5")
+    check(rc == 1 and "motion 2 is running on the board: it would overwrite the move" in err,
+          f"joint move during a motion: exit 1 ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "wait")
+    rc, out, err = run(*on, "joint", "move", "head_yaw=0", "--time", "100", "--wait")
+    check(rc == 0, "after it, the move goes")
+
     rc, out, err = run("--json", *on, "motion", "list")
     ms = json.loads(out)["motions"] if rc == 0 else []
     check([(m["slot"], m["name"]) for m in ms] == [(1, "home"), (2, "wave"), (3, "bow")] and ms[0]["size"] == 52,
@@ -185,6 +243,21 @@ with serve() as dev:
           f"bench against an unpaced board: paced false, {len(b.get('plan_reads', []))} reads")
     rc, out, err = run("--device", dev, "--baud", "1250000", "bench", "--count", "10")
     check(rc == 0 and "warning: faster than 1250000 baud carries the bytes" in out, "and its text warns")
+
+# The README's whole program, as a reader copies it, against the virtual robot.
+if README_JOINTS:
+    with serve() as dev:
+        p = subprocess.run([README_JOINTS, dev], capture_output=True, text=True, timeout=60)
+        lines = p.stdout.splitlines()
+        check(p.returncode == 0 and len(lines) == 20 and lines[0].startswith("head_yaw "),
+              f"the README's joints.cpp reads the 20 joints ({p.returncode}, {p.stderr.strip()!r})")
+        on = ["--device", dev]
+        for _ in range(40):  # the board's output (+6) reaches the target when the 800 ms move ends
+            knee = joints()["left_knee"]
+            if abs(knee["target"] - 40) < 0.1:
+                break
+            time.sleep(0.1)
+        check(abs(knee["target"] - 40) < 0.1, f"and bends the left knee to 40 degrees ({knee['target']})")
 
 # Profiles: the shipped files, another robot, bad files.
 rc, out, err = run("--robot", os.path.join(PROFILES, "kxr-l2.yaml"), "joint", "list")

@@ -379,7 +379,8 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
     timing = m;
     t::error_code ec;
     c2.execute(read, ec);
-    CHECK(ec == t::transport_errc::timeout);
+    // Nothing in time is a timeout; half a reply, then nothing in time, says that it stopped short.
+    CHECK(ec == (m == 3 ? t::error_code(t::transport_errc::timeout) : t::error_code(t::transport_errc::truncated)));
     timing = 0;
     // The late PIO reply has the same shape as the config reply: it must never be taken for it.
     // (The exchange right after may itself time out while the line resynchronises.)

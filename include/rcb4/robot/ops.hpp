@@ -441,6 +441,11 @@ class write_trims {
   errc error() const noexcept { return error_; }
   /** The trims written. */
   const std::vector<joint_trim>& value() const noexcept { return trims_; }
+  /**
+   * Writes the board acknowledged so far, in order: per trim its RAM write, then (persistent)
+   * its ROM write. After a failure, what already changed.
+   */
+  std::size_t written() const noexcept { return step_ > 0 ? step_ - 1 : 0; }
   /** The joint without a block when error() is errc::servo_not_allocated. */
   const joint* unallocated() const noexcept { return unallocated_; }
 

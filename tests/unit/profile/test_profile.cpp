@@ -132,6 +132,22 @@ TEST_CASE("profile: poses in JSON and YAML, written and read back", "[profile]")
   CHECK_THROWS_WITH(parse_pose("{\"joints\": {\"tail\": 3}}", "p.json", m),
                     "p.json:1:13: no joint of test is called 'tail'");
   CHECK_THROWS_WITH(parse_pose("{\"joints\": {\"left_knee\": \"up\"}}", "p.json", m),
-                    "p.json:1:26: left_knee: expected a number, not 'up'");
+                    "p.json:1:26: left_knee: expected a number, not the string \"up\"");
+  CHECK_THROWS_WITH(parse_pose("joints: {left_knee: up}", "p.yaml", m),
+                    "p.yaml:1:21: left_knee: expected a number, not 'up'");
   CHECK_THROWS_WITH(parse_pose("{\"joints\": {}}", "p.json", m), Catch::Contains("joints: expected a mapping"));
+  // A quoted number is a string, in JSON and in YAML.
+  CHECK_THROWS_WITH(parse_pose("{\"joints\": {\"left_knee\": \"10\"}}", "p.json", m),
+                    "p.json:1:26: left_knee: expected a number, not the string \"10\"");
+  CHECK_THROWS_WITH(parse_pose("joints:\n  left_knee: '10'\n", "p.yaml", m),
+                    Catch::Contains("expected a number, not the string"));
+  // Another robot's pose is refused, naming both.
+  CHECK_THROWS_WITH(parse_pose("robot: KXR-L2\njoints: {left_knee: 10}\n", "p.yaml", m),
+                    "p.yaml:1:8: this pose is KXR-L2's, not test's (--robot names the profile it was captured with)");
+}
+
+TEST_CASE("profile: YAML poses carry hundredths, not float noise", "[profile]") {
+  pose p{"test", {{"left_knee", 39.99}, {"right_knee", -0.001}, {"head", 129.995}}, std::nullopt};
+  CHECK(pose_yaml(p) == "robot: test\njoints:\n  left_knee: 39.99\n  right_knee: 0\n  head: 130\n");
+  CHECK(pose_json(p).find("\"right_knee\": 0.0") != std::string::npos);
 }

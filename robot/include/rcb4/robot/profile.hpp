@@ -53,7 +53,10 @@ struct pose {
   std::optional<std::chrono::milliseconds> time;       ///< how long playing it takes, when the file says
 };
 
-/** Parses a pose (JSON or YAML) for @p m: every name must be a joint of @p m. Throws profile_error. */
+/**
+ * Parses a pose (JSON or YAML) for @p m: every name must be a joint of @p m, every angle a bare
+ * number, and its robot (when given) must be @p m's name. Throws profile_error.
+ */
 pose parse_pose(std::string_view text, const std::string& source, const model& m);
 /** Reads a pose file. Throws profile_error. */
 pose load_pose(const std::filesystem::path& path, const model& m);

@@ -40,6 +40,7 @@ enum class transport_errc {
   reconnect_failed,      ///< the link was lost and reopening it failed until the policy gave up
   executor_not_running,  ///< a blocking call waited for the executor, and nobody ran it
   echo,                  ///< the line echoes what is sent (a loopback plug, not a board)
+  truncated,             ///< a reply began but stopped short of its length before the deadline
 };
 
 }  // namespace rcb4::transport
@@ -71,6 +72,7 @@ class transport_category_impl final : public std::error_category {
       case transport_errc::executor_not_running:
         return "nobody runs the client's executor (run it on another thread, e.g. io_thread)";
       case transport_errc::echo: return "the line echoes what is sent: a loopback, not an RCB-4";
+      case transport_errc::truncated: return "the board's reply stopped short of its length before the deadline";
     }
     return "unknown rcb4.transport error";
   }

@@ -287,7 +287,7 @@ class exchange_machine {
       ex_->received(n);
     }
     if (ex_->next() == exchange::step::done) return judge(now);
-    if (r.timed_out) return timed_out(now);
+    if (r.timed_out) return ex_->received_bytes().empty() ? timed_out(now) : truncated(now);
     if (r.ec) return line_failed(r.ec, now);
     return read_into(ex_->read_buffer());
   }
@@ -340,6 +340,12 @@ class exchange_machine {
   action timed_out(clock::time_point now) {
     ++n_->timeouts;
     return attempt_failed(transport_errc::timeout, now);
+  }
+
+  /** A reply began and stopped short: a timeout that says more (a board is there, the line fails). */
+  action truncated(clock::time_point now) {
+    ++n_->timeouts;
+    return attempt_failed(transport_errc::truncated, now);
   }
 
   /**
