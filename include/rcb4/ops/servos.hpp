@@ -118,6 +118,54 @@ class planned_reads {
   std::vector<std::uint8_t> memory_;
   std::size_t step_ = 0;
 };
+
+/**
+ * Reads the allocation table, then @p size bytes at @p offset of every allocated block, in the
+ * reads plan_reads chooses for the link: the shape of read_servo_states and scan_slots.
+ */
+class table_then_reads {
+ public:
+  /** The fields [offset, offset + size) of each block, planned for @p cost. */
+  table_then_reads(std::uint32_t offset, std::uint32_t size, link_cost cost)
+      : offset_(offset), size_(size), cost_(cost) {}
+  /** The next read. */
+  std::optional<command> next() const {
+    if (error_ != errc{}) return std::nullopt;
+    if (!table_read_) return read_allocation();
+    return reads_.next();
+  }
+  /** Takes a reply; true when the last read is in (slots() and word() are then ready). */
+  bool on_reply(const reply& r) {
+    if (!table_read_) {
+      auto slots = allocated_slots(r);
+      if ((error_ = slots.error()) != errc{}) return false;
+      slots_ = std::move(slots).value();
+      std::vector<byte_range> wanted;
+      for (const auto& s : slots_) wanted.push_back({s.address + offset_, size_});
+      reads_ = planned_reads(std::move(wanted), cost_);
+      table_read_ = true;
+      return reads_.done();
+    }
+    return (error_ = reads_.on_reply(r)) == errc{} && reads_.done();
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return error_; }
+  /** The allocated slots, ascending by ICS. */
+  const std::vector<servo_slot>& slots() const noexcept { return slots_; }
+  /** The 16-bit word read at RAM @p a. */
+  std::uint16_t word(std::uint32_t a) const { return reads_.word(a); }
+  /** The reads chosen after the table. */
+  const std::vector<byte_range>& plan() const noexcept { return reads_.plan(); }
+
+ private:
+  std::uint32_t offset_;
+  std::uint32_t size_;
+  link_cost cost_;
+  bool table_read_ = false;
+  std::vector<servo_slot> slots_;
+  planned_reads reads_;
+  errc error_{};
+};
 }  // namespace detail
 
 /** Scans the allocation table: the ICS slots that have a servo block, ascending. */
@@ -158,46 +206,26 @@ struct servo_state {
 class read_servo_states {
  public:
   /** Plans its reads for @p cost (the link's byte time and per-exchange overhead). */
-  explicit read_servo_states(link_cost cost = {}) : cost_(cost) {}
+  explicit read_servo_states(link_cost cost = {}) : reads_(2, 6, cost) {}  // trim, position, target
   /** The next read. */
-  std::optional<command> next() const {
-    if (error_ != errc{}) return std::nullopt;
-    if (!table_read_) return detail::read_allocation();
-    return reads_.next();
-  }
+  std::optional<command> next() const { return reads_.next(); }
   /** Takes a reply. */
   void on_reply(const reply& r) {
-    if (!table_read_) {
-      auto slots = detail::allocated_slots(r);
-      if ((error_ = slots.error()) != errc{}) return;
-      std::vector<byte_range> wanted;
-      blocks_ = std::move(slots).value();
-      for (const auto& b : blocks_) wanted.push_back({b.address + 2u, 6u});  // trim, position, target
-      reads_ = detail::planned_reads(std::move(wanted), cost_);
-      table_read_ = true;
-      return;
-    }
-    if ((error_ = reads_.on_reply(r)) == errc{} && reads_.done()) decode();
+    if (!reads_.on_reply(r)) return;
+    for (const auto& b : reads_.slots())
+      states_.push_back({b.ics, static_cast<std::int16_t>(reads_.word(b.address + 2u)), reads_.word(b.address + 4u),
+                         reads_.word(b.address + 6u)});
   }
   /** errc{} or what went wrong. */
-  errc error() const noexcept { return error_; }
+  errc error() const noexcept { return reads_.error(); }
   /** One state per allocated servo slot, ascending. */
   const std::vector<servo_state>& value() const noexcept { return states_; }
   /** The reads chosen after the table (for inspection and benchmarks). */
   const std::vector<byte_range>& plan() const noexcept { return reads_.plan(); }
 
  private:
-  void decode() {
-    for (const auto& b : blocks_)
-      states_.push_back({b.ics, static_cast<std::int16_t>(reads_.word(b.address + 2u)), reads_.word(b.address + 4u),
-                         reads_.word(b.address + 6u)});
-  }
-  link_cost cost_;
-  bool table_read_ = false;
-  std::vector<servo_slot> blocks_;
-  detail::planned_reads reads_;
+  detail::table_then_reads reads_;
   std::vector<servo_state> states_;
-  errc error_{};
 };
 
 namespace detail {

@@ -30,41 +30,22 @@ struct slot_probe {
 class scan_slots {
  public:
   /** Plans the position reads for @p cost. */
-  explicit scan_slots(link_cost cost = {}) : cost_(cost) {}
+  explicit scan_slots(link_cost cost = {}) : reads_(4, 2, cost) {}
   /** The next read. */
-  std::optional<command> next() const {
-    if (error_ != errc{}) return std::nullopt;
-    if (!table_read_) return detail::read_allocation();
-    return reads_.next();
-  }
+  std::optional<command> next() const { return reads_.next(); }
   /** Takes a reply. */
   void on_reply(const reply& r) {
-    if (!table_read_) {
-      const auto slots = detail::allocated_slots(r);
-      if ((error_ = slots.error()) != errc{}) return;
-      std::vector<byte_range> wanted;
-      for (const auto& s : *slots) {
-        probes_.push_back({s.ics, s.address, 0});
-        wanted.push_back({s.address + 4u, 2u});
-      }
-      reads_ = detail::planned_reads(std::move(wanted), cost_);
-      table_read_ = true;
-      return;
-    }
-    if ((error_ = reads_.on_reply(r)) == errc{} && reads_.done())
-      for (auto& p : probes_) p.position = reads_.word(p.address + 4u);
+    if (!reads_.on_reply(r)) return;
+    for (const auto& s : reads_.slots()) probes_.push_back({s.ics, s.address, reads_.word(s.address + 4u)});
   }
   /** errc{} or what went wrong. */
-  errc error() const noexcept { return error_; }
+  errc error() const noexcept { return reads_.error(); }
   /** The allocated slots, ascending, with their measured positions. */
   const std::vector<slot_probe>& value() const noexcept { return probes_; }
 
  private:
-  link_cost cost_;
-  bool table_read_ = false;
+  detail::table_then_reads reads_;
   std::vector<slot_probe> probes_;
-  detail::planned_reads reads_;
-  errc error_{};
 };
 
 /** A used motion slot. */
