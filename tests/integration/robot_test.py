@@ -163,9 +163,15 @@ with serve() as dev:
     rc, out, err = run(*on, "joint", "move", "head_yaw=5")
     check(rc == 1 and "motion 2 is running on the board: it would overwrite the move" in err,
           f"joint move during a motion: exit 1 ({err.strip()!r})")
-    rc, out, err = run(*on, "motion", "wait")
+    rc, out, err = run(*on, "motion", "stop")
     rc, out, err = run(*on, "joint", "move", "head_yaw=0", "--time", "100", "--wait")
-    check(rc == 0, "after it, the move goes")
+    check(rc == 0, f"after motion stop, the move goes ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "resume")
+    rc, out, err = run(*on, "motion", "wait")
+    # A move of our own under way is no motion: the next move may follow it at once.
+    rc, out, err = run(*on, "joint", "move", "head_yaw=30@2000")
+    rc2, out, err = run(*on, "joint", "move", "left_knee=20")
+    check(rc == 0 and rc2 == 0, f"a move right after another, still interpolating, goes ({rc2}, {err.strip()!r})")
 
     rc, out, err = run("--json", *on, "motion", "list")
     ms = json.loads(out)["motions"] if rc == 0 else []
