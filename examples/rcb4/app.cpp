@@ -302,4 +302,25 @@ failure explain(const std::error_code& ec, std::string_view what) {
   return {exit_io, std::string(what)};
 }
 
+namespace {
+volatile std::sig_atomic_t signal_seen = 0;
+extern "C" void on_caught_signal(int) { signal_seen = 1; }
+}  // namespace
+
+signal_catcher::signal_catcher() {
+  struct sigaction act {};
+  act.sa_handler = on_caught_signal;
+  sigemptyset(&act.sa_mask);
+  act.sa_flags = 0;
+  ::sigaction(SIGINT, &act, &old_int_);
+  ::sigaction(SIGTERM, &act, &old_term_);
+}
+
+signal_catcher::~signal_catcher() {
+  ::sigaction(SIGINT, &old_int_, nullptr);
+  ::sigaction(SIGTERM, &old_term_, nullptr);
+}
+
+bool signal_catcher::caught() noexcept { return signal_seen != 0; }
+
 }  // namespace cli

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include <chrono>
+#include <csignal>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -211,5 +212,24 @@ std::string_view plain_message(std::string_view what);
 
 /** Exit code and hint for an error from the device or the board. */
 failure explain(const std::error_code& ec, std::string_view what);
+
+/**
+ * Catches SIGINT and SIGTERM while it lives (without SA_RESTART, so a blocking read returns), so
+ * that a command can stop cleanly or undo what it did (hold the joints it freed) before it exits.
+ * The previous handlers come back when it goes.
+ */
+class signal_catcher {
+ public:
+  signal_catcher();
+  ~signal_catcher();
+  signal_catcher(const signal_catcher&) = delete;
+  signal_catcher& operator=(const signal_catcher&) = delete;
+  /** True once a signal arrived while a catcher lived. */
+  static bool caught() noexcept;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
 
 }  // namespace cli

@@ -5,7 +5,6 @@
 
 #include <cerrno>
 #include <cmath>
-#include <csignal>
 #include <filesystem>
 #include <iostream>
 #include <thread>
@@ -25,44 +24,13 @@ json rounded(std::optional<double> d) {
   return r == 0 ? 0.0 : r;
 }
 
-volatile std::sig_atomic_t signalled = 0;
-extern "C" void on_capture_signal(int) { signalled = 1; }
-
-bool interrupted_by_signal() { return signalled != 0; }
-
-/**
- * Catches SIGINT and SIGTERM while it lives (without SA_RESTART, so a blocking read returns), so
- * that a command can undo what it did (hold the joints it freed) before it exits.
- */
-class signal_catcher {
- public:
-  signal_catcher() {
-    struct sigaction act {};
-    act.sa_handler = on_capture_signal;
-    sigemptyset(&act.sa_mask);
-    act.sa_flags = 0;
-    ::sigaction(SIGINT, &act, &old_int_);
-    ::sigaction(SIGTERM, &act, &old_term_);
-  }
-  ~signal_catcher() {
-    ::sigaction(SIGINT, &old_int_, nullptr);
-    ::sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  signal_catcher(const signal_catcher&) = delete;
-  signal_catcher& operator=(const signal_catcher&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-};
-
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
 bool wait_for_enter() {
-  for (char c = 0; !signalled;) {
+  for (char c = 0; !signal_catcher::caught();) {
     const auto n = ::read(STDIN_FILENO, &c, 1);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
-    if (c == '\n') return !signalled;
+    if (c == '\n') return !signal_catcher::caught();
   }
   return false;
 }
@@ -384,7 +352,7 @@ void add_pose(CLI::App& app, context& ctx) {
                    plural(js.size(), "joint"));
         if (!wait_for_enter()) {
           s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
-          if (interrupted_by_signal())
+          if (signal_catcher::caught())
             throw failure(exit_interrupted,
                           "interrupted before Enter: nothing captured; the joints hold where they are");
           throw usage_error(
@@ -532,15 +500,15 @@ void add_trim(CLI::App& app, context& ctx) {
       robot::write_trims op(trims, so->persist);
       rcb4::transport::error_code ec;
       s.run_steps(op, ec, [] {});
-      if (ec && op.written() > 0) {
+      if (ec && op.in_ram() > 0) {
         // Some writes landed before the failure: say which, so nobody believes nothing changed.
-        const std::size_t per = so->persist ? 2 : 1;
-        std::vector<std::string> ram, rom;
-        for (std::size_t i = 0; i < op.written(); ++i)
-          (i % per == 0 ? ram : rom).push_back(fmt::format("{} {:+d}", trims[i / per].j->name, trims[i / per].counts));
-        const std::string rom_done = rom.empty() ? std::string("none") : fmt::format("{}", fmt::join(rom, ", "));
-        throw explain(ec, fmt::format("{} (already written: RAM {}{})", ec.message(), fmt::join(ram, ", "),
-                                      so->persist ? "; ROM " + rom_done : std::string()));
+        const auto first_trims = [&](std::size_t n) {
+          std::vector<std::string> out;
+          for (std::size_t i = 0; i < n; ++i) out.push_back(fmt::format("{} {:+d}", trims[i].j->name, trims[i].counts));
+          return out.empty() ? std::string("none") : fmt::format("{}", fmt::join(out, ", "));
+        };
+        throw explain(ec, fmt::format("{} (already written: RAM {}{})", ec.message(), first_trims(op.in_ram()),
+                                      so->persist ? "; ROM " + first_trims(op.in_rom()) : std::string()));
       }
       if (ec) throw rcb4::transport::system_error(ec);
       const auto& done = op.value();

@@ -4,9 +4,7 @@
 
 #include <unistd.h>
 
-#include <atomic>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <thread>
 
@@ -71,9 +69,6 @@ int sensors(session& s, const globals& g) {
   return exit_ok;
 }
 
-std::atomic<bool> interrupted{false};
-extern "C" void on_signal(int) { interrupted = true; }
-
 std::string position_text(std::uint16_t v) {
   if (v == rcb4::servo_position::free_value) return "FREE";
   if (v == rcb4::servo_position::hold_value) return "HOLD";
@@ -83,13 +78,12 @@ std::string position_text(std::uint16_t v) {
 }
 
 int monitor(session& s, long long hz, long long count, const globals& g) {
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  const signal_catcher catcher;  // Ctrl-C ends the monitor after the sample under way
   const bool tty = ::isatty(STDOUT_FILENO) && !g.json;
   const auto period = std::chrono::microseconds(1000000 / hz);
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
-  for (long long n = 0; !interrupted && (count == 0 || n < count); ++n) {
+  for (long long n = 0; !signal_catcher::caught() && (count == 0 || n < count); ++n) {
     const auto states = s.run(rcb4::ops::read_servo_states(rcb4::ops::link_cost::at(s.baud(), 1ms)));
     const auto r = read_all(s);
     const auto now = std::chrono::steady_clock::now();

@@ -78,13 +78,18 @@ void run_at(const robot::model& m, std::chrono::microseconds latency) {
     }
   }
   const command write = targets.frame(frames{1}).value();
-  cycle_shape ours;
-  for (const auto& r : reads.plan()) {
-    ++ours.exchanges;
-    ours.bytes += 10 + r.size + 3;
-  }
-  ++ours.exchanges;
-  ours.bytes += bytes_of(write);
+  // A cycle: the planned reads (10-byte request, size + 3 back), then the write.
+  const auto shape_of = [&](const std::vector<ops::byte_range>& plan) {
+    cycle_shape shape;
+    for (const auto& r : plan) {
+      ++shape.exchanges;
+      shape.bytes += 10 + r.size + 3;
+    }
+    ++shape.exchanges;
+    shape.bytes += bytes_of(write);
+    return shape;
+  };
+  const cycle_shape ours = shape_of(reads.plan());
   // The reads planned for an ideal link, without a per-exchange cost (to show what measuring changed).
   auto other =
       robot::read_joints(map, robot::fields::positions, ops::link_cost::at(baud, std::chrono::microseconds(0)));
@@ -179,13 +184,7 @@ void run_at(const robot::model& m, std::chrono::microseconds latency) {
   row("rcb4 joints: read_joints + CONST20", 0, ours_lim, ours, 2);
   row("  the same, busy_poll 200 us", 1, ours_lim, ours, 2);
   row("  the same by a bare loop (pty floor)", 2, ours_lim, ours, 2);
-  cycle_shape alt;
-  for (const auto& r : other.plan()) {
-    ++alt.exchanges;
-    alt.bytes += 10 + r.size + 3;
-  }
-  ++alt.exchanges;
-  alt.bytes += bytes_of(write);
+  const cycle_shape alt = shape_of(other.plan());
   const auto alt_label = std::to_string(other.plan().size()) + " reads, planned for no exchange cost";
   row(("  " + alt_label).c_str(), 5, alt.limit_us(latency), alt, 5);
   row("iory/rcb4: 5 x MOV 126 + CONST36", 3, iory_lim, theirs, 4);

@@ -6,6 +6,7 @@
 # SPDX-License-Identifier: BSL-1.0
 import json
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -84,6 +85,13 @@ check(len(sensors["ad"]) == 11 and 10.0 < sensors["battery_volts"] < 11.5, "sens
 expect_ok(["sensors"], "battery")
 lines = expect_ok(["--json", "monitor", "--count", "3", "--hz", "20"], "sample").strip().splitlines()
 check(len(lines) == 3 and json.loads(lines[2])["sample"] == 2, "monitor --count 3 --json: three samples")
+# Ctrl-C ends an endless monitor cleanly: exit 0, every line printed whole.
+p = subprocess.Popen([RCB4, "--json", "monitor", "--hz", "50"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+first = p.stdout.readline()
+p.send_signal(signal.SIGINT)
+rest, err = p.communicate(timeout=30)
+check(p.returncode == 0 and json.loads(first)["sample"] == 0 and all(json.loads(l) for l in rest.splitlines()),
+      f"monitor stops at Ctrl-C with exit 0 and whole lines (rc {p.returncode}, {err.strip()[:120]!r})")
 expect_ok(["motion", "play", "2", "--wait", "--timeout", "10"], "done after")
 expect_ok(["motion", "status"], "no motion running")
 expect_ok(["motion", "stop"], "stopped")

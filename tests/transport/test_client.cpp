@@ -192,6 +192,15 @@ TEST_CASE("board_server: a paced reply never comes before the wire would have ca
   }
 }
 
+namespace {
+/** The measured positions (+4) of 20 servo blocks 20 bytes apart, as a KHR-3HV's reads want them. */
+std::vector<ops::byte_range> khr3hv_positions() {
+  std::vector<ops::byte_range> positions;
+  for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
+  return positions;
+}
+}  // namespace
+
 TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per exchange", "[transport][pace]") {
   t::serve_options so;
   so.pace = true;
@@ -206,8 +215,7 @@ TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per 
   CHECK(cost.exchange >= 2000us);   // the board never answers sooner; the wire time is not counted in it
   CHECK(cost.byte_time == 8800ns);  // 11 bits at 1.25 Mbaud
   // Behind such a link the planner reads the 20 servos' positions (+4, 20 bytes apart) in long reads.
-  std::vector<ops::byte_range> positions;
-  for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
+  const auto positions = khr3hv_positions();
   CHECK(ops::plan_reads(positions, cost).size() == 3);  // 7 + 7 + 6 positions: a read of 128 bytes spans 7
   // The line failing is an error, not a cost (shutdown stops the server on its own thread).
   t::board_server::shutdown(b.server);
@@ -228,8 +236,7 @@ TEST_CASE("measure_link: a board that is not paced is measured as it is, not as 
   CHECK(cost.exchange > 0ns);  // an exchange still costs something: the round trip through the pty
   // So the planner merges, as it should on such a link (a read costs little more for more bytes),
   // instead of planning 20 reads for a rate the link does not have.
-  std::vector<ops::byte_range> positions;
-  for (std::uint32_t k = 0; k < 20; ++k) positions.push_back({0x0094 + 20 * k, 2});
+  const auto positions = khr3hv_positions();
   CHECK(ops::plan_reads(positions, cost).size() == 3);
 }
 

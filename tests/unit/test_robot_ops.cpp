@@ -220,9 +220,21 @@ TEST_CASE("robot ops: trims go to RAM +2 and, persistently, to HTH4's servo imag
   w.board().power_on();  // RAM only: gone after a power cycle
   CHECK(w.read_word(0x0090 + 20 * 16 + 2) == 0);
 
+  CHECK(ram_only.in_ram() == 1);
+  CHECK(ram_only.in_rom() == 0);
+
   write_trims kept({std::get<joint_trim>(t)}, true);
   CHECK(run(w, kept).size() == 3);
   REQUIRE(kept.error() == errc{});
+  CHECK(kept.in_ram() == 1);
+  CHECK(kept.in_rom() == 1);
+  // Cut off after the RAM write (the board went away): what changed is known.
+  write_trims cut({std::get<joint_trim>(t)}, true);
+  CHECK(cut.in_ram() == 0);
+  cut.on_reply(w.send(*cut.next()));  // the table
+  cut.on_reply(w.send(*cut.next()));  // RAM +2
+  CHECK(cut.in_ram() == 1);
+  CHECK(cut.in_rom() == 0);
   // ROM 0x00626 + (0x01D0 − 0x0090) + 2 = 0x00768 holds it (protocol.md §8)
   CHECK(w.board().rom()[0x00768] == 0xD4);
   CHECK(w.board().rom()[0x00769] == 0xFF);

@@ -441,15 +441,16 @@ class write_trims {
   errc error() const noexcept { return error_; }
   /** The trims written. */
   const std::vector<joint_trim>& value() const noexcept { return trims_; }
-  /**
-   * Writes the board acknowledged so far, in order: per trim its RAM write, then (persistent)
-   * its ROM write. After a failure, what already changed.
-   */
-  std::size_t written() const noexcept { return step_ > 0 ? step_ - 1 : 0; }
+  /** How many of the trims, from the first, the board has in RAM so far (after a failure: changed). */
+  std::size_t in_ram() const noexcept { return persistent_ ? (acknowledged() + 1) / 2 : acknowledged(); }
+  /** How many of the trims, from the first, are written to ROM so far. */
+  std::size_t in_rom() const noexcept { return persistent_ ? acknowledged() / 2 : 0; }
   /** The joint without a block when error() is errc::servo_not_allocated. */
   const joint* unallocated() const noexcept { return unallocated_; }
 
  private:
+  /** Writes acknowledged: per trim its RAM write, then (persistent) its ROM write. */
+  std::size_t acknowledged() const noexcept { return step_ > 0 ? step_ - 1 : 0; }
   std::vector<joint_trim> trims_;
   bool persistent_;
   std::vector<command> commands_;
