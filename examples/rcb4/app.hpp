@@ -206,6 +206,7 @@ void add_host_commands(CLI::App& app, context& ctx);    ///< list, doctor (cmd_h
 void add_frame_commands(CLI::App& app, context& ctx);   ///< decode, encode (cmd_frames.cpp)
 void add_serve_command(CLI::App& app, context& ctx);    ///< serve (cmd_serve.cpp)
 void add_robot_commands(CLI::App& app, context& ctx);   ///< joint, pose, trim, scan (cmd_robot.cpp)
+void add_ui_command(CLI::App& app, context& ctx);       ///< ui (cmd_ui.cpp, ui/)
 
 /** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
 std::string_view plain_message(std::string_view what);

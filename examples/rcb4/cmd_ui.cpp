@@ -1,0 +1,162 @@
+// rcb4 command-line tool: ui (the robot in a browser: joints, poses, motions, sensors, link).
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+#include "ui/board_loop.hpp"
+#include "ui/server.hpp"
+
+#include <boost/asio/ip/host_name.hpp>
+#include <boost/asio/signal_set.hpp>
+
+#include <cstdio>
+#include <random>
+#include <thread>
+
+namespace cli {
+namespace {
+
+struct ui_options {
+  std::string listen = "127.0.0.1:8080";
+  std::string token;
+  std::string poses = "poses";
+  std::string layout = "2.2";
+  double speed = 90;
+};
+
+boost::asio::ip::tcp::endpoint endpoint_of(const std::string& text) {
+  const auto colon = text.rfind(':');
+  if (colon == std::string::npos || colon == 0)
+    throw usage_error(fmt::format("--listen: expected HOST:PORT (e.g. 127.0.0.1:8080, [::1]:0), not '{}'", text));
+  auto host = text.substr(0, colon);
+  if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
+  const auto port = parse_int(std::string_view(text).substr(colon + 1), "--listen port", 0, 65535);
+  boost::system::error_code ec;
+  const auto address = host == "localhost" ? boost::asio::ip::make_address("127.0.0.1")
+                                           : boost::asio::ip::make_address(host, ec);
+  if (ec) throw usage_error(fmt::format("--listen: '{}' is not an IP address (or localhost)", host));
+  return {address, static_cast<unsigned short>(port)};
+}
+
+/** 128 random bits as 32 hex digits. */
+std::string new_token() {
+  std::random_device rd;
+  std::string out;
+  for (int i = 0; i < 4; ++i) out += fmt::format("{:08x}", rd());
+  return out;
+}
+
+std::string url_of(const boost::asio::ip::tcp::endpoint& ep, const std::string& token) {
+  std::string host;
+  if (ep.address().is_unspecified()) {
+    boost::system::error_code ec;
+    host = boost::asio::ip::host_name(ec);
+    if (ec || host.empty()) host = "HOST";
+  } else if (ep.address().is_v6()) {
+    host = "[" + ep.address().to_string() + "]";
+  } else {
+    host = ep.address().to_string();
+  }
+  return fmt::format("http://{}:{}/{}", host, ep.port(), token.empty() ? "" : "?token=" + token);
+}
+
+int run_ui(context& ctx, const ui_options& o) {
+  const auto& m = robot_of(ctx.g);
+  ui::server_options so;
+  so.listen = endpoint_of(o.listen);
+  so.token = o.token;
+  if (!so.listen.address().is_loopback() && so.token.empty()) so.token = new_token();
+  for (char c : so.token)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
+      throw usage_error("--token: use letters, digits, - and _ (it goes in a URL and a cookie)");
+
+  boost::asio::io_context io;
+  std::optional<ui::web_server> server;
+  try {
+    server.emplace(io, so);
+  } catch (const boost::system::system_error& e) {
+    throw failure(exit_io, fmt::format("cannot listen on {}: {}", o.listen, e.code().message()),
+                  e.code() == boost::asio::error::address_in_use ? "another program has that port: --listen 127.0.0.1:0 "
+                                                                   "picks a free one"
+                                                                 : "");
+  }
+
+  session s(ctx.g);  // the device (or the in-process virtual robot): its failures exit 1/3/4 as everywhere
+
+  ui::settings limits;
+  limits.max_speed = o.speed;
+  ui::hub h(m, limits, [&server](ui::client_id to, std::string text) { server->send(to, std::move(text)); });
+  ui::loop_options lo;
+  lo.poses = o.poses;
+  lo.layout = o.layout == "1.3" ? &rcb4::hth4_1_3 : (o.layout == "2.0" || o.layout == "2.1") ? &rcb4::hth4_2_0
+                                                                                              : &rcb4::hth4_2_2;
+  lo.device = s.where();
+  h.set_hello(ui::hello_text(m, s, lo, limits));
+
+  // The first line of stdout is the URL (scripts read it); the rest goes to stderr.
+  fmt::print("{}\n", url_of(server->local(), so.token));
+  std::fflush(stdout);
+  fmt::print(stderr, "rcb4 ui: {} on {}; poses in {}; Ctrl-C stops\n", m.name(), s.where(), o.poses);
+
+  std::string loop_failure;
+  std::thread loop([&] {
+    try {
+      ui::run_board_loop(s, m, h, lo);
+    } catch (const std::exception& e) {
+      loop_failure = e.what();
+      boost::asio::post(io, [&] { server->stop(); });
+    }
+  });
+  bool stopped = false;
+  const auto stop_all = [&] {
+    if (stopped) return;
+    stopped = true;
+    h.stop();
+    loop.join();  // at most one exchange's deadline
+    server->stop();
+  };
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  signals.async_wait([&](const boost::system::error_code& ec, int) {
+    if (!ec) stop_all();
+  });
+  server->start(h);
+  io.run();
+  signals.cancel();
+  if (!stopped) {  // the loop failed and stopped the server
+    h.stop();
+    loop.join();
+    stopped = true;
+  }
+  if (!loop_failure.empty()) throw failure(exit_board, "the board loop stopped: " + loop_failure);
+  fmt::print(stderr, "rcb4 ui: stopped\n");
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_ui_command(CLI::App& app, context& ctx) {
+  auto* cmd = app.add_subcommand(
+      "ui", "the robot in a browser: live joints, sliders, free/hold, poses, motions, sensors and the link");
+  auto o = std::make_shared<ui_options>();
+  cmd->add_option("--listen", o->listen,
+                  "HOST:PORT to serve on (default 127.0.0.1:8080; port 0 picks a free one). Any address other "
+                  "than loopback needs a token")
+      ->type_name("HOST:PORT");
+  cmd->add_option("--token", o->token,
+                  "the secret every request must carry (?token=, then a cookie); generated and printed in the URL "
+                  "when --listen is not loopback and none is given")
+      ->type_name("T");
+  cmd->add_option("--poses", o->poses, "where poses are saved and found (NAME.yaml; default ./poses)")->type_name("DIR");
+  cmd->add_option("--speed", o->speed, "the fastest a page may move a joint, degrees per second (default 90)")
+      ->type_name("DEG_PER_S")
+      ->check(CLI::Range(1.0, 1000.0));
+  cmd->add_option("--layout", o->layout, "the HeartToHeart4 version that wrote the motions (see motion play)")
+      ->check(CLI::IsMember({"1.3", "2.0", "2.1", "2.2"}));
+  cmd->footer(
+      "Prints the URL as the first line of stdout and serves until SIGINT/SIGTERM (exit 0).\n"
+      "Open it in a browser on this machine, or from another one over SSH:\n"
+      "  ssh -L 8080:127.0.0.1:8080 robot-pc   then http://127.0.0.1:8080/ on yours");
+  cmd->callback([&ctx, o] {
+    ctx.action = [&ctx, o] { return run_ui(ctx, *o); };
+  });
+}
+
+}  // namespace cli

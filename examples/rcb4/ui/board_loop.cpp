@@ -1,0 +1,438 @@
+// rcb4 ui: the board loop (see board_loop.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include "board_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <system_error>
+
+namespace cli::ui {
+namespace {
+
+namespace robot = rcb4::robot;
+namespace ops = rcb4::ops;
+namespace t = rcb4::transport;
+using namespace std::chrono_literals;
+
+/** A number for the page: rounded to hundredths, null when unknown. */
+json degrees_json(std::optional<double> d) {
+  if (!d || !std::isfinite(*d)) return nullptr;
+  const double r = std::round(*d * 100) / 100;
+  return r == 0 ? 0.0 : r;
+}
+
+std::string text_of(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
+/** An error for a page: the words of the failure, and its hint. */
+std::string words_of(const std::error_code ec, std::string_view what) {
+  const auto f = explain(ec, what);
+  std::string s = fmt::format("{}: {}", what, plain_message(ec.message()));
+  if (!f.hint.empty()) s += " (" + f.hint + ")";
+  return s;
+}
+
+/** A failure while carrying out an action, with words for the page. */
+struct refusal {
+  std::string what;
+};
+
+class loop {
+ public:
+  loop(session& s, const robot::model& m, hub& h, const loop_options& o) : s_(s), m_(m), h_(h), o_(o) {
+    angles_.resize(m.joints().size());
+    targets_.resize(m.joints().size());
+    modes_.resize(m.joints().size(), "unknown");
+    last_rate_at_ = clock::now();
+  }
+
+  void run() {
+    bool lists_sent = false;
+    while (!h_.stopped()) {
+      const auto start = clock::now();
+      for (auto& a : h_.take()) carry_out(a);
+      poll();
+      if (answering_ && !lists_sent) {  // after the first state: a page shows the robot at once
+        refresh_lists();
+        lists_sent = true;
+      }
+      const auto pause = answering_ ? o_.period : 500ms;  // a silent board is tried twice a second
+      if (!h_.wait_until(start + pause)) break;
+    }
+  }
+
+ private:
+  /** Runs @p op; its value, or a default one with @p ec set. */
+  template <class Op>
+  auto run_ec(Op op, t::error_code& ec) {
+    t::run(s_.c(), op, ec);
+    return op.value();
+  }
+
+  // --- reading -------------------------------------------------------------------------------
+  void poll() {
+    t::error_code ec;
+    if (!reader_) locate(ec);
+    if (!ec) {
+      reader_->restart();
+      s_.run_steps(*reader_, ec, [] {});
+    }
+    std::optional<ops::analog_inputs> analog;
+    std::optional<ops::motion_state> motion;
+    if (!ec) analog = run_ec(ops::read_analog{}, ec);
+    if (!ec) motion = run_ec(ops::read_motion_state(*o_.layout), ec);
+    if (!ec) rom_program_ = run_ec(ops::read_config{}, ec).rom_program;
+    answering_ = !ec;
+    if (ec) {
+      error_ = words_of(ec, "reading the robot");
+      reader_.reset();  // locate again: the board may have been reset or replaced
+      std::fill(angles_.begin(), angles_.end(), std::nullopt);
+      std::fill(targets_.begin(), targets_.end(), std::nullopt);
+      motion_ = {};
+    } else {
+      const auto& rs = reader_->value();
+      for (std::size_t i = 0; i < rs.size(); ++i) {
+        angles_[i] = rs[i].degrees();
+        targets_[i] = rs[i].target_degrees();
+        modes_[i] = !rs[i].allocated    ? "missing"
+                    : rs[i].is_free()   ? "free"
+                    : rs[i].is_hold()   ? "hold"
+                    : !rs[i].answered() ? "silent"
+                                        : "on";
+      }
+      motion_ = *motion;
+      analog_ = *analog;
+    }
+    h_.observe(targets_);
+    h_.set_state(state_text());
+  }
+
+  void locate(t::error_code& ec) {
+    auto op = robot::locate_joints(m_);
+    s_.run_steps(op, ec, [] {});
+    if (ec) return;
+    map_ = op.value();
+    reader_.emplace(map_, robot::fields::state, ops::link_cost::at(s_.baud(), 1ms));
+  }
+
+  std::string state_text() {
+    const auto now = clock::now();
+    const auto& k = s_.c().counters();
+    const auto exchanges = k.exchanges.load();
+    if (now - last_rate_at_ >= 1s) {
+      rate_ = static_cast<double>(exchanges - last_exchanges_) / std::chrono::duration<double>(now - last_rate_at_).count();
+      last_exchanges_ = exchanges;
+      last_rate_at_ = now;
+    }
+    json j;
+    j["type"] = "state";
+    j["seq"] = ++seq_;
+    j["answering"] = answering_;
+    j["error"] = answering_ ? json(nullptr) : json(error_);
+    json a = json::array(), g = json::array(), md = json::array();
+    for (std::size_t i = 0; i < angles_.size(); ++i) {
+      a.push_back(degrees_json(angles_[i]));
+      g.push_back(degrees_json(targets_[i]));
+      md.push_back(answering_ ? modes_[i] : "unknown");
+    }
+    j["angles"] = std::move(a);
+    j["targets"] = std::move(g);
+    j["modes"] = std::move(md);
+    if (answering_) {
+      j["battery"] = std::round(analog_.battery_volts * 100) / 100;
+      json ad = json::array();
+      for (std::size_t c = 1; c < analog_.values.size(); ++c) ad.push_back(analog_.values[c]);
+      j["ad"] = std::move(ad);
+    } else {
+      j["battery"] = nullptr;
+      j["ad"] = nullptr;
+    }
+    json mo;
+    mo["running"] = motion_.running;
+    mo["slot"] = motion_.motion ? json(*motion_.motion) : json(nullptr);
+    mo["rom_program"] = rom_program_;
+    mo["progress"] = nullptr;
+    if (motion_.motion)
+      for (const auto& v : motions_)
+        if (v.number == *motion_.motion && v.size > 0 && motion_.program_counter >= v.address)
+          mo["progress"] =
+              std::round(std::min(1.0, (motion_.program_counter - v.address) / static_cast<double>(v.size)) * 1000) /
+              1000;
+    j["motion"] = std::move(mo);
+    json link;
+    link["exchanges"] = exchanges;
+    link["per_second"] = std::round(rate_ * 10) / 10;
+    link["errors"] = k.errors.load();
+    link["timeouts"] = k.timeouts.load();
+    link["nacks"] = k.nacks.load();
+    j["link"] = std::move(link);
+    return text_of(j);
+  }
+
+  // --- lists ---------------------------------------------------------------------------------
+  std::vector<std::string> pose_names() const {
+    std::vector<std::string> out;
+    t::error_code ec;
+    for (auto it = std::filesystem::directory_iterator(o_.poses, ec); !ec && it != std::filesystem::directory_iterator();
+         it.increment(ec)) {
+      const auto& p = it->path();
+      if (!(p.extension() == ".yaml" || p.extension() == ".json")) continue;
+      const auto stem = p.stem().string();
+      if (valid_pose_name(stem) && std::find(out.begin(), out.end(), stem) == out.end()) out.push_back(stem);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  void refresh_lists() {
+    if (answering_) {
+      ops::list_motions op(*o_.layout);
+      t::error_code ec;
+      s_.run_steps(op, ec, [] {});
+      if (!ec) motions_ = op.value();
+    }
+    json j;
+    j["type"] = "lists";
+    j["poses"] = pose_names();
+    json ms = json::array();
+    for (const auto& v : motions_) {
+      const auto name = m_.motion(v.number);
+      ms.push_back({{"slot", v.number},
+                    {"name", name.empty() ? json(nullptr) : json(std::string(name))},
+                    {"frames", v.frames},
+                    {"readable", v.readable}});
+    }
+    j["motions"] = std::move(ms);
+    j["poses_dir"] = o_.poses.string();
+    h_.set_lists(text_of(j));
+  }
+
+  // --- actions -------------------------------------------------------------------------------
+  void carry_out(const action& a) {
+    const std::string_view op = std::visit(
+        [](const auto& b) -> std::string_view {
+          using B = std::decay_t<decltype(b)>;
+          if constexpr (std::is_same_v<B, move_action>) return "move";
+          else if constexpr (std::is_same_v<B, power_action>) return b.free ? "free" : "hold";
+          else if constexpr (std::is_same_v<B, stop_action>) return "stop";
+          else if constexpr (std::is_same_v<B, capture_action>) return "capture";
+          else if constexpr (std::is_same_v<B, play_pose_action>) return "play_pose";
+          else if constexpr (std::is_same_v<B, motion_play_action>) return "motion_play";
+          else if constexpr (std::is_same_v<B, motion_stop_action>) return "motion_stop";
+          else return "refresh";
+        },
+        a.body);
+    try {
+      json extra = std::visit([&](const auto& b) { return act(b); }, a.body);
+      // Slider moves come without an id; they are answered only when they fail.
+      if (a.id || !std::holds_alternative<move_action>(a.body))
+        if (a.from) h_.tell(a.from, reply_text(a.id, op, extra.is_null() ? std::string() : text_of(extra)));
+    } catch (const refusal& r) {
+      if (a.from) h_.tell(a.from, error_text(a.id, op, r.what));
+    }
+  }
+
+  /** Runs @p op on the board; a failure is a refusal in the page's words. */
+  template <class Op>
+  auto must(Op op, std::string_view what) {
+    t::error_code ec;
+    auto v = run_ec(std::move(op), ec);
+    if (ec) {
+      if (std::error_code(ec).category() != rcb4::codec_category()) answering_ = false;
+      throw refusal{words_of(ec, what)};
+    }
+    return v;
+  }
+
+  void located() {
+    if (reader_) return;
+    t::error_code ec;
+    locate(ec);
+    if (ec) throw refusal{words_of(ec, "locating the joints")};
+  }
+
+  void refuse_during_motion() {
+    if (motion_.running && motion_.motion && rom_program_)
+      throw refusal{fmt::format("motion {} is running on the board: stop it first (the move would fight it)",
+                                *motion_.motion)};
+  }
+
+  /** Moves @p targets (checked here again: nothing from a page is trusted). */
+  json move(std::vector<robot::joint_target> targets) {
+    refuse_during_motion();
+    auto checked = robot::check_targets(m_, targets, 0ms);
+    if (!robot::ok(checked)) throw refusal{std::get<robot::problem>(checked).message};
+    auto moves = std::get<std::vector<robot::joint_move>>(std::move(checked));
+    located();
+    for (const auto& mv : moves)
+      if (!map_.block_of(*mv.j)) throw refusal{mv.j->name + ": the board has no servo block for it (see rcb4 scan)"};
+    robot::move_joints op(std::move(moves));
+    t::error_code ec;
+    s_.run_steps(op, ec, [] {});
+    if (ec) throw refusal{words_of(ec, "move")};
+    std::chrono::milliseconds longest{0};
+    for (const auto& mv : op.value())
+      longest = std::max(longest, std::chrono::milliseconds(mv.frames * rcb4::milliseconds(op.period())));
+    return json{{"ms", longest.count()}, {"joints", op.value().size()}};
+  }
+
+  json act(const move_action& a) { return move(a.targets); }
+
+  rcb4::servo_mask mask_of(const std::vector<const robot::joint*>& joints, std::vector<std::string>* missing) {
+    located();
+    rcb4::servo_mask mask;
+    for (const auto* j : joints) {
+      if (map_.block_of(*j))
+        mask.insert(j->ics);
+      else if (missing)
+        missing->push_back(j->name);
+    }
+    return mask;
+  }
+
+  json act(const power_action& a) {
+    std::vector<std::string> missing;
+    const auto mask = mask_of(a.joints, &missing);
+    if (mask.empty()) throw refusal{"none of these joints has a servo block on the board (see rcb4 scan)"};
+    must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask),
+         a.free ? "free" : "hold");
+    return json{{"joints", a.joints.size() - missing.size()}, {"missing", missing}};
+  }
+
+  json act(const stop_action& a) {
+    json out;
+    if (a.motion && motion_.running) {
+      must(ops::stop_motion{}, "stop the motion");
+      out["motion_stopped"] = true;
+    }
+    const auto mask = mask_of(a.joints, nullptr);
+    if (!mask.empty()) must(ops::set_servo_power(ops::power_state::hold, mask), "hold");
+    out["held"] = a.joints.size();
+    return out;
+  }
+
+  std::filesystem::path pose_path(const std::string& name, bool for_reading) const {
+    const auto yaml = o_.poses / (name + ".yaml");
+    if (!for_reading) return yaml;
+    t::error_code ec;
+    if (std::filesystem::exists(yaml, ec)) return yaml;
+    return o_.poses / (name + ".json");
+  }
+
+  json act(const capture_action& a) {
+    const auto path = pose_path(a.name, false);
+    std::error_code fec;
+    if (!a.force && std::filesystem::exists(path, fec))
+      throw refusal{fmt::format("a pose called '{}' exists already: replace it, or choose another name", a.name)};
+    located();
+    auto rs = must(robot::read_joints(map_, robot::fields::positions, ops::link_cost::at(s_.baud(), 1ms)),
+                   "read the joints");
+    robot::pose p{m_.name(), {}, std::nullopt};
+    std::vector<std::string> left_out;
+    for (const auto& r : rs) {
+      if (const auto d = r.degrees()) {
+        // Hundredths, within the limits: a servo a hair beyond must not make the pose unplayable.
+        p.joints.emplace_back(r.j->name, std::clamp(std::round(*d * 100) / 100, r.j->lower, r.j->upper));
+      } else {
+        left_out.push_back(r.j->name);
+      }
+    }
+    if (p.joints.empty()) throw refusal{"no joint answered: nothing to capture"};
+    try {
+      std::filesystem::create_directories(o_.poses);
+      robot::save_pose(path, p);
+    } catch (const std::exception& e) {
+      throw refusal{fmt::format("cannot save {}: {}", path.string(), plain_message(e.what()))};
+    }
+    refresh_lists();
+    return json{{"name", a.name}, {"file", path.string()}, {"joints", p.joints.size()}, {"left_out", left_out}};
+  }
+
+  json act(const play_pose_action& a) {
+    const auto path = pose_path(a.name, true);
+    robot::pose p;
+    try {
+      p = robot::load_pose(path, m_);
+    } catch (const std::exception& e) {
+      throw refusal{std::string(plain_message(e.what()))};
+    }
+    // The slowest joint sets the pace: no joint moves faster than the speed limit.
+    double span = 0;
+    for (const auto& [name, d] : p.joints) {
+      const auto* j = m_.find(name);
+      const auto i = static_cast<std::size_t>(j - m_.joints().data());
+      span = std::max(span, angles_[i] ? std::abs(d - *angles_[i]) : j->upper - j->lower);
+    }
+    auto time = a.ms ? std::chrono::milliseconds(*a.ms) : p.time.value_or(h_.limits().default_pose_ms);
+    time = std::max(time, paced_time(span, h_.limits()));
+    std::vector<robot::joint_target> targets;
+    for (const auto& [name, d] : p.joints) targets.push_back({name, d, time});
+    auto out = move(std::move(targets));
+    out["name"] = a.name;
+    return out;
+  }
+
+  json act(const motion_play_action& a) {
+    must(ops::play_motion(a.slot, *o_.layout, ops::servo_power::keep), "play the motion");
+    return json{{"slot", a.slot}};
+  }
+
+  json act(const motion_stop_action&) {
+    must(ops::stop_motion{}, "stop the motion");
+    return nullptr;
+  }
+
+  json act(const refresh_action&) {
+    refresh_lists();
+    return nullptr;
+  }
+
+  session& s_;
+  const robot::model& m_;
+  hub& h_;
+  const loop_options& o_;
+  robot::joint_map map_;
+  std::optional<robot::read_joints> reader_;
+  std::vector<std::optional<double>> angles_, targets_;
+  std::vector<std::string> modes_;
+  ops::analog_inputs analog_{};
+  ops::motion_state motion_{};
+  bool rom_program_ = false;
+  std::vector<ops::motion_slot> motions_;
+  bool answering_ = false;
+  std::string error_;
+  std::uint64_t seq_ = 0;
+  std::uint64_t last_exchanges_ = 0;
+  double rate_ = 0;
+  clock::time_point last_rate_at_;
+};
+
+}  // namespace
+
+void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) {
+  loop(s, m, h, o).run();
+}
+
+std::string hello_text(const robot::model& m, const session& s, const loop_options& o, const settings& limits) {
+  json j;
+  j["type"] = "hello";
+  j["robot"] = m.name();
+  json joints = json::array();
+  for (const auto& jt : m.joints())
+    joints.push_back({{"name", jt.name}, {"ics", jt.ics.value()}, {"lower", jt.lower}, {"upper", jt.upper}});
+  j["joints"] = std::move(joints);
+  json groups = json::array();
+  for (const auto& g : m.groups()) groups.push_back({{"name", g.name}, {"joints", g.joints}});
+  j["groups"] = std::move(groups);
+  json link;
+  link["device"] = s.where();
+  link["baud"] = s.rate_known() ? json(s.baud()) : json(nullptr);
+  link["virtual"] = s.is_virtual();
+  j["link"] = std::move(link);
+  j["max_speed"] = limits.max_speed;
+  j["max_move_ms"] = max_move_ms;
+  j["period_ms"] = o.period.count();
+  j["version"] = RCB4_VERSION;
+  return text_of(j);
+}
+
+}  // namespace cli::ui

@@ -1,0 +1,100 @@
+// rcb4 ui: the messages a page sends over its WebSocket, parsed and checked (sans-I/O).
+// SPDX-License-Identifier: BSL-1.0
+//
+// One JSON object per text message, with "op" naming what it asks and an optional integer "id"
+// that the server's answer repeats:
+//
+//   {"op":"control"}                                   ask to control the robot (one page at a time)
+//   {"op":"release"}                                   give control up
+//   {"op":"move","joints":{"left_knee":40},"ms":300}   joint targets in degrees (ms optional)
+//   {"op":"free","joints":["left_arm"]}                joints, groups or "all": no torque
+//   {"op":"hold","joints":["all"]}                     torque on where they are
+//   {"op":"stop"}                                      hold every joint now, stop a motion
+//   {"op":"capture","name":"wave","force":false}       save the current pose as wave.yaml
+//   {"op":"play_pose","name":"wave","ms":1200}         play a saved pose
+//   {"op":"motion_play","slot":2}, {"op":"motion_stop"} the ROM motions
+//   {"op":"refresh"}                                   read the pose and motion lists again
+//
+// Anything else (not JSON, an unknown op or key, a wrong type, a value out of range, more than
+// max_message_bytes, nesting deeper than an object of arrays) is a parse_error with the reason.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <variant>
+#include <vector>
+
+namespace cli::ui {
+
+/** The longest message a page may send; longer ones are refused unread. */
+inline constexpr std::size_t max_message_bytes = 16 * 1024;
+/** The longest joint, group or pose name a message may carry. */
+inline constexpr std::size_t max_name_bytes = 64;
+/** The longest move or pose time a message may ask, ms (255 frames of 25 ms, protocol.md §5). */
+inline constexpr int max_move_ms = 6375;
+
+/** {"op":"control"}: make this page the controlling one. */
+struct take_control {};
+/** {"op":"release"}: this page stops controlling. */
+struct release_control {};
+/** {"op":"move"}: joint targets in degrees, in the order given; ms: how long (else the server picks). */
+struct move_request {
+  std::vector<std::pair<std::string, double>> joints;  ///< joint name → degrees
+  std::optional<int> ms;                               ///< 0..max_move_ms
+};
+/** {"op":"free"} / {"op":"hold"}: torque off or on for joints, groups or "all". */
+struct power_request {
+  bool free = false;               ///< true: free, false: hold
+  std::vector<std::string> words;  ///< joint or group names, "all"
+};
+/** {"op":"stop"}: hold every joint where it is and stop a running motion. */
+struct stop_request {};
+/** {"op":"capture"}: save the measured pose under @p name. */
+struct capture_request {
+  std::string name;    ///< [A-Za-z0-9_-], 1..64 bytes
+  bool force = false;  ///< replace a pose of that name
+};
+/** {"op":"play_pose"}: play the saved pose @p name. */
+struct play_pose_request {
+  std::string name;       ///< as capture names it
+  std::optional<int> ms;  ///< 0..max_move_ms; else the pose's own time or the server's default
+};
+/** {"op":"motion_play"}: play ROM motion @p slot. */
+struct motion_play_request {
+  unsigned slot = 0;  ///< 1..120
+};
+/** {"op":"motion_stop"}: suspend the ROM program. */
+struct motion_stop_request {};
+/** {"op":"refresh"}: read the saved poses and the motion slots again. */
+struct refresh_request {};
+
+/** What a page asks. */
+using request = std::variant<take_control, release_control, move_request, power_request, stop_request,
+                             capture_request, play_pose_request, motion_play_request, motion_stop_request,
+                             refresh_request>;
+
+/** A well-formed message: its request and the id to answer with. */
+struct message {
+  std::optional<std::int64_t> id;  ///< the page's id for the answer
+  request body;                    ///< what it asks
+};
+
+/** A message that cannot be used: why, and its id when one could be read. */
+struct parse_error {
+  std::optional<std::int64_t> id;  ///< the id, when the message had a valid one
+  std::string what;                ///< e.g. "move: 'joints' must be an object of numbers"
+};
+
+/** Parses one text message from a page. Never throws; any input gives a message or a parse_error. */
+std::variant<message, parse_error> parse_message(std::string_view text);
+
+/** True for a pose name a page may use: 1..64 of [A-Za-z0-9_-] (no dots, no slashes). */
+bool valid_pose_name(std::string_view name) noexcept;
+
+/** The op name of @p r ("move", "free" …), for answers. */
+std::string_view op_name(const request& r) noexcept;
+
+}  // namespace cli::ui

@@ -1,0 +1,333 @@
+// rcb4 ui: the page. One WebSocket to the server that owns the board; no library, no network
+// beyond this server. Messages: examples/rcb4/ui/messages.hpp (to the server), board_loop.cpp
+// and controller.cpp (from it).
+'use strict';
+
+const $ = (sel) => document.querySelector(sel);
+const el = (tag, attrs = {}, ...kids) => {
+  const e = document.createElement(tag);
+  for (const [k, v] of Object.entries(attrs)) {
+    if (k === 'class') e.className = v;
+    else if (k === 'text') e.textContent = v;
+    else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
+    else e.setAttribute(k, v);
+  }
+  for (const k of kids) e.append(k);
+  return e;
+};
+const fmtDeg = (d) => (d === null || d === undefined ? '–' : (d > 0 ? '+' : '') + d.toFixed(1) + '°');
+
+const ui = {
+  ws: null,
+  hello: null,
+  role: 'view',
+  rows: new Map(),       // joint name → {row, slider, angle, target, marker, j, index}
+  dragging: new Map(),   // joint name → time the page last moved its slider
+  sendTimer: null,
+  pendingMoves: {},
+  nextId: 1,
+  history: [],           // [{t, battery, ad:[…]}] over the last 30 s
+  lastState: null,
+  motions: [],
+};
+
+// --- the connection -------------------------------------------------------------------------------
+
+function connect() {
+  const token = new URLSearchParams(location.search).get('token');
+  const url = `ws://${location.host}/ws` + (token ? `?token=${encodeURIComponent(token)}` : '');
+  const ws = new WebSocket(url);
+  ui.ws = ws;
+  ws.onmessage = (ev) => {
+    let m;
+    try { m = JSON.parse(ev.data); } catch { return; }
+    on[m.type]?.(m);
+  };
+  ws.onclose = () => {
+    setLink(false, 'no connection to rcb4 ui: is it still running? retrying…');
+    setRole('view', false);
+    setTimeout(connect, 1000);
+  };
+}
+
+function send(msg) {
+  if (ui.ws?.readyState !== WebSocket.OPEN) return null;
+  msg.id ??= ui.nextId++;
+  ui.ws.send(JSON.stringify(msg));
+  return msg.id;
+}
+
+function say(text, kind = 'note') {
+  const m = $('#message');
+  m.textContent = text;
+  m.className = 'message show' + (kind === 'error' ? ' error' : '');
+  clearTimeout(say.timer);
+  say.timer = setTimeout(() => { m.className = 'message'; m.textContent = ''; }, kind === 'error' ? 8000 : 4000);
+}
+
+// --- what the server sends --------------------------------------------------------------------------
+
+const on = {
+  hello(m) {
+    ui.hello = m;
+    document.title = `${m.robot} — rcb4 ui`;
+    $('#robot').textContent = m.robot;
+    $('#version').textContent = `rcb4 ${m.version}`;
+    buildJoints(m);
+  },
+  role(m) { setRole(m.role, m.controlled); },
+  lists(m) {
+    ui.motions = m.motions;
+    renderPoses(m.poses, m.poses_dir);
+    renderMotions();
+  },
+  state(m) {
+    ui.lastState = m;
+    renderState(m);
+  },
+  reply(m) {
+    const what = {
+      capture: () => `captured ${m.joints} joints as ${m.name}` + (m.left_out?.length ? ` (left out: ${m.left_out.join(', ')})` : ''),
+      play_pose: () => `playing ${m.name} over ${m.ms} ms`,
+      motion_play: () => `playing motion ${m.slot}`,
+      motion_stop: () => 'motion stopped',
+      stop: () => 'stopped: every joint holds where it is',
+      free: () => `${m.joints} joints free` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
+      hold: () => `${m.joints} joints holding` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
+      control: () => 'this page controls the robot',
+      release: () => 'control released',
+    }[m.op];
+    if (what) say(what());
+  },
+  note(m) { say((m.clamped || []).join('; ')); },
+  error(m) { say((m.op ? m.op + ': ' : '') + m.message, 'error'); },
+};
+
+// --- joints -----------------------------------------------------------------------------------------
+
+function buildJoints(h) {
+  const box = $('#joints');
+  box.replaceChildren();
+  ui.rows.clear();
+  const inGroup = new Set();
+  const groups = h.groups.filter((g) => g.joints.length);
+  for (const g of groups) g.joints.forEach((n) => inGroup.add(n));
+  const rest = h.joints.filter((j) => !inGroup.has(j.name)).map((j) => j.name);
+  if (rest.length) groups.push({ name: groups.length ? 'other' : 'all', joints: rest, synthetic: true });
+  const byName = new Map(h.joints.map((j, i) => [j.name, { ...j, index: i }]));
+  // A group whose joints all show in earlier cards (arms = left arm + right arm) gets buttons only.
+  const shown = new Set();
+  const bar = el('div', { class: 'group wide', 'data-group': '(sets)' }, el('h2', {}, 'groups'));
+  for (const g of groups) {
+    if (g.joints.every((n) => shown.has(n))) {
+      const words = [g.name];
+      bar.append(el('span', { class: 'set', 'data-set': g.name }, g.name.replaceAll('_', ' '), ' ',
+        el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'free', joints: words }) }, 'Free'),
+        ' ',
+        el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'hold', joints: words }) }, 'Hold')));
+      continue;
+    }
+    g.joints.forEach((n) => shown.add(n));
+    const card = el('div', { class: 'group', 'data-group': g.name });
+    const words = g.synthetic ? g.joints : [g.name];
+    card.append(el('h2', {}, g.name.replaceAll('_', ' '),
+      el('span', { class: 'actions' },
+        el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'free', joints: words }) }, 'Free'),
+        ' ',
+        el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'hold', joints: words }) }, 'Hold'))));
+    for (const n of g.joints) {
+      if (ui.rows.has(n)) continue;  // a joint in two groups is shown once, in the first
+      card.append(jointRow(byName.get(n)));
+    }
+    box.append(card);
+  }
+  if (bar.childElementCount > 1) box.append(bar);
+}
+
+function jointRow(j) {
+  const slider = el('input', {
+    type: 'range', min: j.lower, max: j.upper, step: 0.5, value: Math.min(Math.max(0, j.lower), j.upper),
+    'data-joint': j.name, 'aria-label': `${j.name} target in degrees`,
+  });
+  const marker = el('span', { class: 'measured', title: 'measured angle' });
+  const angle = el('span', { class: 'angle', text: '–', title: 'measured angle' });
+  const target = el('span', { class: 'target', text: '' });
+  const row = el('div', { class: 'joint', 'data-joint': j.name },
+    el('span', { class: 'name', text: j.name, title: `ICS ${j.ics}` }),
+    el('div', { class: 'slider' }, slider, marker),
+    angle,
+    el('span', { class: 'power' },
+      el('button', { type: 'button', title: 'no torque', onclick: () => send({ op: 'free', joints: [j.name] }) }, 'free'),
+      el('button', { type: 'button', title: 'torque on where it is', onclick: () => send({ op: 'hold', joints: [j.name] }) }, 'hold')),
+    el('span', { class: 'target-line' }, target),
+    el('div', { class: 'limits' }, el('span', { text: `${j.lower}°` }), el('span', { text: `${j.upper}°` })));
+  slider.addEventListener('input', () => {
+    ui.dragging.set(j.name, performance.now());
+    ui.pendingMoves[j.name] = Number(slider.value);
+    target.textContent = `→ ${fmtDeg(Number(slider.value))}`;
+    if (!ui.sendTimer) ui.sendTimer = setTimeout(flushMoves, 40);  // at most 25 messages a second
+  });
+  ui.rows.set(j.name, { row, slider, angle, target, marker, j });
+  return row;
+}
+
+function flushMoves() {
+  ui.sendTimer = null;
+  const joints = ui.pendingMoves;
+  ui.pendingMoves = {};
+  if (Object.keys(joints).length) ui.ws?.readyState === WebSocket.OPEN && ui.ws.send(JSON.stringify({ op: 'move', joints }));
+}
+
+function renderState(s) {
+  const h = ui.hello;
+  if (!h) return;
+  const now = performance.now();
+  h.joints.forEach((j, i) => {
+    const r = ui.rows.get(j.name);
+    if (!r) return;
+    const mode = s.modes[i];
+    r.row.className = 'joint ' + mode;
+    r.angle.textContent = fmtDeg(s.angles[i]);
+    if (s.angles[i] !== null) {
+      const f = (s.angles[i] - j.lower) / (j.upper - j.lower);
+      r.marker.style.left = `calc(${(Math.min(Math.max(f, 0), 1) * 100).toFixed(2)}% - 1px)`;
+      r.marker.hidden = false;
+    } else {
+      r.marker.hidden = true;
+    }
+    const t = s.targets[i];
+    const moved = ui.dragging.get(j.name);
+    const recent = moved !== undefined && now - moved < 800;
+    if (!recent) {
+      r.target.textContent = mode === 'free' ? 'free' : mode === 'hold' ? 'hold' : t === null ? '' : `target ${fmtDeg(t)}`;
+      r.target.dataset.degrees = t === null ? '' : String(t);
+      if (t !== null && document.activeElement !== r.slider) r.slider.value = t;
+    }
+  });
+  renderLink(s);
+  renderMotion(s.motion);
+  recordSensors(s);
+}
+
+// --- the link, the role -------------------------------------------------------------------------------
+
+function setLink(ok, text) {
+  $('#dot').className = 'dot ' + (ok ? 'ok' : 'bad');
+  $('#link-text').textContent = text;
+}
+
+function renderLink(s) {
+  const l = ui.hello.link;
+  const where = `${l.device}${l.baud ? ` · ${l.baud} baud` : ''}`;
+  const counts = `${s.link.per_second.toFixed(0)} exchanges/s · ${s.link.errors} errors`;
+  setLink(s.answering, s.answering ? `${where} · ${counts}` : `${where} · board not answering: ${s.error}`);
+  $('#link').dataset.answering = String(s.answering);
+}
+
+function setRole(role, controlled) {
+  ui.role = role;
+  document.body.classList.toggle('view', role !== 'control');
+  const badge = $('#role');
+  badge.textContent = role === 'control' ? 'controlling' : controlled ? 'watching (another page controls)' : 'watching';
+  badge.className = 'badge' + (role === 'control' ? ' control' : '');
+  const b = $('#control');
+  b.textContent = role === 'control' ? 'Release' : 'Take control';
+  b.disabled = role !== 'control' && controlled;
+}
+
+// --- poses and motions -------------------------------------------------------------------------------
+
+function renderPoses(poses, dir) {
+  const list = $('#poses');
+  list.replaceChildren(...poses.map((p) => el('li', { 'data-pose': p },
+    el('span', { text: p }),
+    el('button', { type: 'button', class: 'play needs-control', onclick: () => playPose(p) }, 'Play'))));
+  if (!poses.length) list.append(el('li', { class: 'muted', text: 'no pose saved yet' }));
+  $('#poses-dir').textContent = dir ? `saved in ${dir}` : '';
+}
+
+function playPose(name) {
+  const ms = Number($('#pose-ms').value);
+  send({ op: 'play_pose', name, ms: Number.isFinite(ms) ? Math.min(Math.max(Math.round(ms), 0), 6375) : undefined });
+}
+
+function renderMotions() {
+  const list = $('#motions');
+  list.replaceChildren(...ui.motions.map((m) => el('li', { 'data-motion': m.slot },
+    el('span', { text: `${m.slot} ${m.name ?? ''}`.trim() + (m.readable ? '' : ' (unreadable)') }),
+    el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'motion_play', slot: m.slot }) }, 'Play'))));
+  if (!ui.motions.length) list.append(el('li', { class: 'muted', text: 'no motion in ROM' }));
+}
+
+function renderMotion(m) {
+  const text = m.running ? (m.slot ? `motion ${m.slot} running` : 'the ROM program runs outside the motion slots')
+                         : 'no motion running';
+  $('#motion-state').textContent = text;
+  $('#motion-progress').value = m.progress ?? 0;
+  for (const li of document.querySelectorAll('#motions li[data-motion]'))
+    li.classList.toggle('running', m.running && String(m.slot) === li.dataset.motion);
+}
+
+// --- sensors -----------------------------------------------------------------------------------------
+
+const adColours = ['#2f6fdf', '#d0342c', '#1f9d55', '#c77700', '#7b3fc4', '#0f9aa8', '#b83280', '#5a6372', '#8c6d1f', '#3f51b5'];
+
+function recordSensors(s) {
+  const t = performance.now() / 1000;
+  if (s.battery !== null) ui.history.push({ t, battery: s.battery, ad: s.ad });
+  while (ui.history.length && ui.history[0].t < t - 30) ui.history.shift();
+  $('#battery').textContent = s.battery === null ? '–' : `${s.battery.toFixed(2)} V`;
+  if (!recordSensors.drawn || t - recordSensors.drawn > 0.2) {  // drawn 5 times a second: calm, cheap
+    recordSensors.drawn = t;
+    plot($('#battery-plot'), t, [(p) => p.battery], ['#2f6fdf'], null);
+    plot($('#ad-plot'), t, adColours.map((_, k) => (p) => p.ad[k]), adColours, [0, 1023]);
+  }
+}
+
+function plot(canvas, now, series, colours, fixed) {
+  const g = canvas.getContext('2d');
+  const w = canvas.width, h = canvas.height;
+  g.clearRect(0, 0, w, h);
+  const pts = ui.history;
+  if (!pts.length) return;
+  let lo = fixed ? fixed[0] : Infinity, hi = fixed ? fixed[1] : -Infinity;
+  if (!fixed) for (const p of pts) for (const f of series) { lo = Math.min(lo, f(p)); hi = Math.max(hi, f(p)); }
+  if (hi - lo < 0.2) { const mid = (hi + lo) / 2; lo = mid - 0.1; hi = mid + 0.1; }
+  const x = (t) => ((t - (now - 30)) / 30) * w;
+  const y = (v) => h - 4 - ((v - lo) / (hi - lo)) * (h - 16);
+  g.font = '10px system-ui, sans-serif';
+  g.fillStyle = '#6b7385';
+  g.fillText(fixed ? String(hi) : hi.toFixed(2), 2, 10);
+  g.fillText(fixed ? String(lo) : lo.toFixed(2), 2, h - 2);
+  series.forEach((f, k) => {
+    g.strokeStyle = colours[k];
+    g.lineWidth = 1.2;
+    g.beginPath();
+    pts.forEach((p, i) => (i ? g.lineTo(x(p.t), y(f(p))) : g.moveTo(x(p.t), y(f(p)))));
+    g.stroke();
+  });
+}
+
+// --- the buttons ----------------------------------------------------------------------------------------
+
+function wire() {
+  $('#control').addEventListener('click', () => send({ op: ui.role === 'control' ? 'release' : 'control' }));
+  $('#free-all').addEventListener('click', () => send({ op: 'free', joints: ['all'] }));
+  $('#hold-all').addEventListener('click', () => send({ op: 'hold', joints: ['all'] }));
+  $('#stop').addEventListener('click', () => send({ op: 'stop' }));
+  $('#motion-stop').addEventListener('click', () => send({ op: 'motion_stop' }));
+  $('#refresh').addEventListener('click', () => send({ op: 'refresh' }));
+  $('#capture-form').addEventListener('submit', (ev) => {
+    ev.preventDefault();
+    send({ op: 'capture', name: $('#pose-name').value.trim(), force: $('#pose-force').checked });
+  });
+  const legend = $('#ad-legend');
+  adColours.forEach((c, k) => {
+    const s = el('span', { text: `AD${k + 1}` });
+    s.style.setProperty('--c', c);
+    legend.append(s);
+  });
+}
+
+wire();
+connect();
