@@ -15,6 +15,7 @@ packages=(
   python3                              # a client in another language for the virtual board tests
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)
+  chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
 )
 
 missing=()

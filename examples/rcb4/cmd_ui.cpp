@@ -30,8 +30,8 @@ boost::asio::ip::tcp::endpoint endpoint_of(const std::string& text) {
   if (host.size() > 2 && host.front() == '[' && host.back() == ']') host = host.substr(1, host.size() - 2);
   const auto port = parse_int(std::string_view(text).substr(colon + 1), "--listen port", 0, 65535);
   boost::system::error_code ec;
-  const auto address = host == "localhost" ? boost::asio::ip::make_address("127.0.0.1")
-                                           : boost::asio::ip::make_address(host, ec);
+  const auto address =
+      host == "localhost" ? boost::asio::ip::make_address("127.0.0.1") : boost::asio::ip::make_address(host, ec);
   if (ec) throw usage_error(fmt::format("--listen: '{}' is not an IP address (or localhost)", host));
   return {address, static_cast<unsigned short>(port)};
 }
@@ -74,9 +74,10 @@ int run_ui(context& ctx, const ui_options& o) {
     server.emplace(io, so);
   } catch (const boost::system::system_error& e) {
     throw failure(exit_io, fmt::format("cannot listen on {}: {}", o.listen, e.code().message()),
-                  e.code() == boost::asio::error::address_in_use ? "another program has that port: --listen 127.0.0.1:0 "
-                                                                   "picks a free one"
-                                                                 : "");
+                  e.code() == boost::asio::error::address_in_use
+                      ? "another program has that port: --listen 127.0.0.1:0 "
+                        "picks a free one"
+                      : "");
   }
 
   session s(ctx.g);  // the device (or the in-process virtual robot): its failures exit 1/3/4 as everywhere
@@ -86,8 +87,9 @@ int run_ui(context& ctx, const ui_options& o) {
   ui::hub h(m, limits, [&server](ui::client_id to, std::string text) { server->send(to, std::move(text)); });
   ui::loop_options lo;
   lo.poses = o.poses;
-  lo.layout = o.layout == "1.3" ? &rcb4::hth4_1_3 : (o.layout == "2.0" || o.layout == "2.1") ? &rcb4::hth4_2_0
-                                                                                              : &rcb4::hth4_2_2;
+  lo.layout = o.layout == "1.3"                          ? &rcb4::hth4_1_3
+              : (o.layout == "2.0" || o.layout == "2.1") ? &rcb4::hth4_2_0
+                                                         : &rcb4::hth4_2_2;
   lo.device = s.where();
   h.set_hello(ui::hello_text(m, s, lo, limits));
 
@@ -144,7 +146,8 @@ void add_ui_command(CLI::App& app, context& ctx) {
                   "the secret every request must carry (?token=, then a cookie); generated and printed in the URL "
                   "when --listen is not loopback and none is given")
       ->type_name("T");
-  cmd->add_option("--poses", o->poses, "where poses are saved and found (NAME.yaml; default ./poses)")->type_name("DIR");
+  cmd->add_option("--poses", o->poses, "where poses are saved and found (NAME.yaml; default ./poses)")
+      ->type_name("DIR");
   cmd->add_option("--speed", o->speed, "the fastest a page may move a joint, degrees per second (default 90)")
       ->type_name("DEG_PER_S")
       ->check(CLI::Range(1.0, 1000.0));
@@ -154,9 +157,7 @@ void add_ui_command(CLI::App& app, context& ctx) {
       "Prints the URL as the first line of stdout and serves until SIGINT/SIGTERM (exit 0).\n"
       "Open it in a browser on this machine, or from another one over SSH:\n"
       "  ssh -L 8080:127.0.0.1:8080 robot-pc   then http://127.0.0.1:8080/ on yours");
-  cmd->callback([&ctx, o] {
-    ctx.action = [&ctx, o] { return run_ui(ctx, *o); };
-  });
+  cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { return run_ui(ctx, *o); }; });
 }
 
 }  // namespace cli

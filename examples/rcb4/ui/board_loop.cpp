@@ -80,7 +80,11 @@ class loop {
     std::optional<ops::motion_state> motion;
     if (!ec) analog = run_ec(ops::read_analog{}, ec);
     if (!ec) motion = run_ec(ops::read_motion_state(*o_.layout), ec);
-    if (!ec) rom_program_ = run_ec(ops::read_config{}, ec).rom_program;
+    if (!ec) {
+      const auto cfg = run_ec(ops::read_config{}, ec);
+      rom_program_ = cfg.rom_program;
+      period_ = cfg.period;
+    }
     answering_ = !ec;
     if (ec) {
       error_ = words_of(ec, "reading the robot");
@@ -119,7 +123,8 @@ class loop {
     const auto& k = s_.c().counters();
     const auto exchanges = k.exchanges.load();
     if (now - last_rate_at_ >= 1s) {
-      rate_ = static_cast<double>(exchanges - last_exchanges_) / std::chrono::duration<double>(now - last_rate_at_).count();
+      rate_ =
+          static_cast<double>(exchanges - last_exchanges_) / std::chrono::duration<double>(now - last_rate_at_).count();
       last_exchanges_ = exchanges;
       last_rate_at_ = now;
     }
@@ -172,8 +177,8 @@ class loop {
   std::vector<std::string> pose_names() const {
     std::vector<std::string> out;
     t::error_code ec;
-    for (auto it = std::filesystem::directory_iterator(o_.poses, ec); !ec && it != std::filesystem::directory_iterator();
-         it.increment(ec)) {
+    for (auto it = std::filesystem::directory_iterator(o_.poses, ec);
+         !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
       const auto& p = it->path();
       if (!(p.extension() == ".yaml" || p.extension() == ".json")) continue;
       const auto stem = p.stem().string();
@@ -211,14 +216,22 @@ class loop {
     const std::string_view op = std::visit(
         [](const auto& b) -> std::string_view {
           using B = std::decay_t<decltype(b)>;
-          if constexpr (std::is_same_v<B, move_action>) return "move";
-          else if constexpr (std::is_same_v<B, power_action>) return b.free ? "free" : "hold";
-          else if constexpr (std::is_same_v<B, stop_action>) return "stop";
-          else if constexpr (std::is_same_v<B, capture_action>) return "capture";
-          else if constexpr (std::is_same_v<B, play_pose_action>) return "play_pose";
-          else if constexpr (std::is_same_v<B, motion_play_action>) return "motion_play";
-          else if constexpr (std::is_same_v<B, motion_stop_action>) return "motion_stop";
-          else return "refresh";
+          if constexpr (std::is_same_v<B, move_action>)
+            return "move";
+          else if constexpr (std::is_same_v<B, power_action>)
+            return b.free ? "free" : "hold";
+          else if constexpr (std::is_same_v<B, stop_action>)
+            return "stop";
+          else if constexpr (std::is_same_v<B, capture_action>)
+            return "capture";
+          else if constexpr (std::is_same_v<B, play_pose_action>)
+            return "play_pose";
+          else if constexpr (std::is_same_v<B, motion_play_action>)
+            return "motion_play";
+          else if constexpr (std::is_same_v<B, motion_stop_action>)
+            return "motion_stop";
+          else
+            return "refresh";
         },
         a.body);
     try {
@@ -252,13 +265,18 @@ class loop {
 
   void refuse_during_motion() {
     if (motion_.running && motion_.motion && rom_program_)
-      throw refusal{fmt::format("motion {} is running on the board: stop it first (the move would fight it)",
-                                *motion_.motion)};
+      throw refusal{
+          fmt::format("motion {} is running on the board: stop it first (the move would fight it)", *motion_.motion)};
   }
 
   /** Moves @p targets (checked here again: nothing from a page is trusted). */
   json move(std::vector<robot::joint_target> targets) {
     refuse_during_motion();
+    // A CONST frame carries 255 frames at most (protocol.md §5): 2.55 s on a 10 ms board. A longer
+    // time (a page's, or the speed limit's) becomes the slowest move the board can make.
+    const auto slowest = std::chrono::milliseconds(255 * rcb4::milliseconds(period_));
+    for (auto& t : targets)
+      if (t.time && *t.time > slowest) t.time = slowest;
     auto checked = robot::check_targets(m_, targets, 0ms);
     if (!robot::ok(checked)) throw refusal{std::get<robot::problem>(checked).message};
     auto moves = std::get<std::vector<robot::joint_move>>(std::move(checked));
@@ -324,8 +342,8 @@ class loop {
     if (!a.force && std::filesystem::exists(path, fec))
       throw refusal{fmt::format("a pose called '{}' exists already: replace it, or choose another name", a.name)};
     located();
-    auto rs = must(robot::read_joints(map_, robot::fields::positions, ops::link_cost::at(s_.baud(), 1ms)),
-                   "read the joints");
+    auto rs =
+        must(robot::read_joints(map_, robot::fields::positions, ops::link_cost::at(s_.baud(), 1ms)), "read the joints");
     robot::pose p{m_.name(), {}, std::nullopt};
     std::vector<std::string> left_out;
     for (const auto& r : rs) {
@@ -397,6 +415,7 @@ class loop {
   ops::analog_inputs analog_{};
   ops::motion_state motion_{};
   bool rom_program_ = false;
+  rcb4::output_period period_ = rcb4::output_period::ms10;
   std::vector<ops::motion_slot> motions_;
   bool answering_ = false;
   std::string error_;
@@ -408,9 +427,7 @@ class loop {
 
 }  // namespace
 
-void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) {
-  loop(s, m, h, o).run();
-}
+void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) { loop(s, m, h, o).run(); }
 
 std::string hello_text(const robot::model& m, const session& s, const loop_options& o, const settings& limits) {
   json j;

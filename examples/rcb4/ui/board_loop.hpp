@@ -13,10 +13,10 @@ namespace cli::ui {
 
 /** What the loop needs besides the session. */
 struct loop_options {
-  std::filesystem::path poses;                        ///< where poses are saved and read (NAME.yaml)
+  std::filesystem::path poses;                       ///< where poses are saved and read (NAME.yaml)
   const rcb4::rom_layout* layout = &rcb4::hth4_2_2;  ///< where the motions are in ROM
-  std::chrono::milliseconds period{33};               ///< one reading per period at most (~30 a second)
-  std::string device;                                 ///< for the page: what is open
+  std::chrono::milliseconds period{33};              ///< one reading per period at most (~30 a second)
+  std::string device;                                ///< for the page: what is open
 };
 
 /**

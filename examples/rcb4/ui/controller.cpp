@@ -48,10 +48,7 @@ std::chrono::milliseconds paced_time(double degrees, const settings& s) {
 }
 
 controller::controller(const robot::model& m, settings s)
-    : model_(&m),
-      settings_(s),
-      observed_(m.joints().size()),
-      commanded_(m.joints().size()) {}
+    : model_(&m), settings_(s), observed_(m.joints().size()), commanded_(m.joints().size()) {}
 
 std::size_t controller::index_of(const robot::joint* j) const noexcept {
   return static_cast<std::size_t>(j - model_->joints().data());
@@ -115,10 +112,10 @@ bool controller::admit(client_id c, clock::time_point now, effects& e) {
   }
   if (!p.warned) {
     p.warned = true;
-    e.letters.push_back({c, error_text(std::nullopt, {},
-                                       "too many messages: at most " +
-                                           robot::number_text(settings_.messages_per_second) +
-                                           " a second; the others are dropped")});
+    e.letters.push_back(
+        {c, error_text(std::nullopt, {},
+                       "too many messages: at most " + robot::number_text(settings_.messages_per_second) +
+                           " a second; the others are dropped")});
   }
   return false;
 }
@@ -190,8 +187,8 @@ void controller::handle(client_id c, const message& m, effects& e) {
       const double d = std::clamp(degrees, j->lower, j->upper);
       if (d != degrees)
         clamped.push_back(name + ": " + robot::number_text(degrees) + " is beyond its " +
-                          (degrees < j->lower ? "lower" : "upper") + " limit " + robot::number_text(d) +
-                          ": moved to " + robot::number_text(d));
+                          (degrees < j->lower ? "lower" : "upper") + " limit " + robot::number_text(d) + ": moved to " +
+                          robot::number_text(d));
       accepted.emplace_back(i, d);
     }
     for (const auto& [i, d] : accepted) pending_[i] = {d, mv->ms, c};

@@ -36,10 +36,10 @@ using clock = std::chrono::steady_clock;
 
 /** The controller's limits. */
 struct settings {
-  double max_speed = 90;                           ///< degrees per second no move from a page exceeds
-  std::chrono::milliseconds move_interval{40};     ///< at most one move frame per interval (25 a second)
-  double messages_per_second = 60;                 ///< per page, sustained
-  double message_burst = 120;                      ///< per page, at once
+  double max_speed = 90;                            ///< degrees per second no move from a page exceeds
+  std::chrono::milliseconds move_interval{40};      ///< at most one move frame per interval (25 a second)
+  double messages_per_second = 60;                  ///< per page, sustained
+  double message_burst = 120;                       ///< per page, at once
   std::chrono::milliseconds default_pose_ms{1000};  ///< a pose played without a time of its own
 };
 
@@ -49,7 +49,7 @@ struct move_action {
 };
 /** Free or hold joints. */
 struct power_action {
-  bool free = false;                               ///< true: free, false: hold
+  bool free = false;                              ///< true: free, false: hold
   std::vector<const rcb4::robot::joint*> joints;  ///< which
 };
 /** Hold @p joints where they are (a stop or a lost page), and stop a running motion. */
@@ -148,12 +148,12 @@ class controller {
   settings settings_;
   std::map<client_id, page> pages_;
   std::optional<client_id> controller_;
-  std::map<std::size_t, pending> pending_;           ///< joint index → latest slider target
-  std::vector<std::optional<double>> observed_;      ///< per joint: the board's target
-  std::vector<std::optional<double>> commanded_;     ///< per joint: the last target sent from a page
-  std::set<std::size_t> moved_;                      ///< joints the controlling page moved
-  bool started_motion_ = false;                      ///< the controlling page played a motion
-  std::optional<clock::time_point> last_move_;       ///< when due_move last gave a move
+  std::map<std::size_t, pending> pending_;        ///< joint index → latest slider target
+  std::vector<std::optional<double>> observed_;   ///< per joint: the board's target
+  std::vector<std::optional<double>> commanded_;  ///< per joint: the last target sent from a page
+  std::set<std::size_t> moved_;                   ///< joints the controlling page moved
+  bool started_motion_ = false;                   ///< the controlling page played a motion
+  std::optional<clock::time_point> last_move_;    ///< when due_move last gave a move
 };
 
 /** {"type":"error","id":…,"op":…,"message":…} */

@@ -72,9 +72,8 @@ struct motion_stop_request {};
 struct refresh_request {};
 
 /** What a page asks. */
-using request = std::variant<take_control, release_control, move_request, power_request, stop_request,
-                             capture_request, play_pose_request, motion_play_request, motion_stop_request,
-                             refresh_request>;
+using request = std::variant<take_control, release_control, move_request, power_request, stop_request, capture_request,
+                             play_pose_request, motion_play_request, motion_stop_request, refresh_request>;
 
 /** A well-formed message: its request and the id to answer with. */
 struct message {

@@ -4,6 +4,7 @@
 
 #include <boost/asio/dispatch.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <cctype>
 #include <deque>
+#include <utility>
 
 namespace cli::ui {
 
@@ -61,8 +63,7 @@ bool same_origin(std::string_view origin, std::string_view host) noexcept {
 
 bool same_secret(std::string_view a, std::string_view b) noexcept {
   unsigned char diff = a.size() == b.size() ? 0 : 1;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+  for (std::size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
   return diff == 0;
 }
 
@@ -156,12 +157,10 @@ void common_headers(http::response<Body>& res) {
 /** One page's WebSocket: reads its messages into the hub, writes what the hub sends it. */
 class ws_session : public std::enable_shared_from_this<ws_session> {
  public:
-  ws_session(tcp::socket&& socket, web_server& server) : ws_(std::move(socket)), server_(server) {}
+  ws_session(tcp::socket&& socket, web_server& server)
+      : ws_(std::move(socket)), cutoff_(ws_.get_executor()), server_(server) {}
   ~ws_session() {
-    if (id_) {
-      server_.remove(id_);
-      if (auto* h = server_.events()) h->leave(id_);
-    }
+    gone();
     server_.close_connection();
   }
 
@@ -187,16 +186,23 @@ class ws_session : public std::enable_shared_from_this<ws_session> {
     }
     if (out_.size() >= 256) {  // a page that reads nothing: let it go
       close();
+      gone();
       return;
     }
     out_.push_back(std::move(text));
     if (out_.size() == 1) write();
   }
 
+  /** Starts the close handshake; a peer that does not answer it within a second is cut off. */
   void close() {
     if (closing_) return;
-    closing_ = true;
-    ws_.async_close(websocket::close_code::going_away, [self = shared_from_this()](beast::error_code) {});
+    closing_ = true;  // the read that fails next makes it gone()
+    cutoff_.expires_after(1s);
+    cutoff_.async_wait([self = shared_from_this()](beast::error_code ec) {
+      if (!ec) beast::get_lowest_layer(self->ws_).close();
+    });
+    ws_.async_close(websocket::close_code::going_away,
+                    [self = shared_from_this()](beast::error_code) { self->cutoff_.cancel(); });
   }
 
  private:
@@ -211,8 +217,17 @@ class ws_session : public std::enable_shared_from_this<ws_session> {
     ws_.async_read(in_, [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
 
+  /** The page is gone (closed, lost, too slow, refused): it hears nothing more, the hub learns it once. */
+  void gone() {
+    closing_ = true;
+    if (!id_) return;
+    const auto id = std::exchange(id_, 0);
+    server_.remove(id);
+    if (auto* h = server_.events()) h->leave(id);
+  }
+
   void on_read(beast::error_code ec) {
-    if (ec) return;  // closed, timed out, too long, or the server stops: the session ends
+    if (ec) return gone();  // closed, timed out, too long, or the server stops: the session ends
     auto* h = server_.events();
     if (!ws_.got_text()) {
       queue(error_text(std::nullopt, {}, "messages are JSON text, not binary"));
@@ -225,21 +240,21 @@ class ws_session : public std::enable_shared_from_this<ws_session> {
 
   void write() {
     ws_.text(true);
-    ws_.async_write(net::buffer(out_.front()), [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      self->on_write(ec);
-    });
+    ws_.async_write(net::buffer(out_.front()),
+                    [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_write(ec); });
   }
 
   void on_write(beast::error_code ec) {
     if (ec) {
       out_.clear();
-      return;
+      return gone();
     }
     out_.pop_front();
     if (!out_.empty() && !closing_) write();
   }
 
   websocket::stream<beast::tcp_stream> ws_;
+  net::steady_timer cutoff_;
   web_server& server_;
   beast::flat_buffer in_;
   std::deque<std::string> out_;
@@ -259,6 +274,9 @@ class http_session : public std::enable_shared_from_this<http_session> {
   }
 
   void run() {
+    server_.track(weak_from_this(), [weak = weak_from_this()] {
+      if (auto self = weak.lock()) self->stream_.close();  // the server stops: a kept-alive read ends now
+    });
     net::dispatch(stream_.get_executor(), [self = shared_from_this()] { self->read(); });
   }
 
@@ -350,6 +368,14 @@ void web_server::stop() {
   acceptor_.close(ec);
   for (auto& [id, w] : pages_)
     if (auto s = w.lock()) s->close();
+  for (auto& [owner, closer] : closers_)
+    if (!owner.expired()) closer();
+  closers_.clear();
+}
+
+void web_server::track(std::weak_ptr<void> owner, std::function<void()> closer) {
+  std::erase_if(closers_, [](const auto& c) { return c.first.expired(); });
+  closers_.emplace_back(std::move(owner), std::move(closer));
 }
 
 net::ip::tcp::endpoint web_server::local() const { return acceptor_.local_endpoint(); }
@@ -389,7 +415,7 @@ void web_server::close_connection() noexcept {
 }
 
 void web_server::accept() {
-  acceptor_.async_accept(net::make_strand(io_), [this](beast::error_code ec, tcp::socket socket) {
+  acceptor_.async_accept(io_, [this](beast::error_code ec, tcp::socket socket) {
     if (ec == net::error::operation_aborted || stopping_) return;
     if (!ec) {
       if (open_connection()) {

@@ -18,11 +18,14 @@
 #include <boost/asio/ip/tcp.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <span>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace cli::ui {
 
@@ -75,6 +78,8 @@ class web_server {
   bool open_connection();
   /** A connection closed. */
   void close_connection() noexcept;
+  /** Remembers how to close an HTTP connection when the server stops. */
+  void track(std::weak_ptr<void> owner, std::function<void()> closer);
   /** True once stop() ran. */
   bool stopping() const noexcept { return stopping_; }
 
@@ -87,6 +92,7 @@ class web_server {
   boost::asio::ip::tcp::acceptor acceptor_;
   hub* hub_ = nullptr;
   std::map<client_id, std::weak_ptr<ws_session>> pages_;
+  std::vector<std::pair<std::weak_ptr<void>, std::function<void()>>> closers_;  ///< HTTP connections
   client_id next_id_ = 1;
   std::size_t connections_ = 0;
   bool stopping_ = false;
