@@ -1,11 +1,12 @@
 // libFuzzer harness: rcb4 ui's page messages (examples/rcb4/ui: parse_message and the controller).
 // The input is split at newlines into messages from two pages (even lines: page 1, which
-// controls; odd: page 2, which watches), each 10 ms after the last. Properties:
+// controls first; odd: page 2, which watches until it takes control), each 10 ms after the last.
+// Properties:
 //   - parse_message never throws and gives a message or a parse_error with a reason;
 //   - every letter the controller writes is one valid JSON object with a "type";
-//   - the watching page never causes an action;
+//   - a page that does not control causes no action but a refresh;
 //   - every move sent is to a joint of the model, within its limits, over 40..6375 ms;
-//   - after the controlling page leaves, nothing more moves.
+//   - once both pages left, nothing more moves.
 // SPDX-License-Identifier: BSL-1.0
 #include "controller.hpp"
 #include "messages.hpp"
@@ -71,16 +72,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     auto end = all.find('\n', start);
     if (end == std::string_view::npos) end = all.size();
     const client_id from = line % 2 == 0 ? 1 : 2;
+    const bool controlled = c.controlling() == from;
     const auto e = c.receive(from, all.substr(start, end - start), now);
     check_letters(e);
-    if (from == 2)
-      check(e.actions.empty() || (e.actions.size() == 1 && std::holds_alternative<refresh_action>(e.actions[0].body)));
+    // A page that did not control when it spoke causes no action but a refresh (or taking control).
+    if (!controlled)
+      for (const auto& a : e.actions) check(std::holds_alternative<refresh_action>(a.body));
     now += std::chrono::milliseconds(10);
     check_moves(c.due_move(now));
     start = end + 1;
     ++line;
   }
   check_letters(c.leave(1));
-  check(!c.due_move(now + std::chrono::hours(1)));
+  check_letters(c.leave(2));
+  check(!c.due_move(now + std::chrono::hours(1)));  // nobody left: nothing moves
   return 0;
 }

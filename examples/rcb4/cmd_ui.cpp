@@ -98,35 +98,37 @@ int run_ui(context& ctx, const ui_options& o) {
   std::fflush(stdout);
   fmt::print(stderr, "rcb4 ui: {} on {}; poses in {}; Ctrl-C stops\n", m.name(), s.where(), o.poses);
 
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   std::string loop_failure;
   std::thread loop([&] {
     try {
       ui::run_board_loop(s, m, h, lo);
     } catch (const std::exception& e) {
       loop_failure = e.what();
-      boost::asio::post(io, [&] { server->stop(); });
+      boost::asio::post(io, [&] {
+        signals.cancel();
+        server->stop();
+      });
     }
   });
-  bool stopped = false;
-  const auto stop_all = [&] {
-    if (stopped) return;
-    stopped = true;
-    h.stop();
-    loop.join();  // at most one exchange's deadline
-    server->stop();
-  };
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
+  // Whatever happens next, the loop thread ends before what it uses goes.
+  struct joiner {
+    ui::hub& h;
+    std::thread& t;
+    ~joiner() {
+      h.stop();
+      if (t.joinable()) t.join();
+    }
+  } join_loop{h, loop};
   signals.async_wait([&](const boost::system::error_code& ec, int) {
-    if (!ec) stop_all();
+    if (ec) return;
+    h.stop();  // the loop ends after the exchange under way; joined once io.run() returns
+    server->stop();
   });
   server->start(h);
   io.run();
-  signals.cancel();
-  if (!stopped) {  // the loop failed and stopped the server
-    h.stop();
-    loop.join();
-    stopped = true;
-  }
+  h.stop();
+  loop.join();
   if (!loop_failure.empty()) throw failure(exit_board, "the board loop stopped: " + loop_failure);
   fmt::print(stderr, "rcb4 ui: stopped\n");
   return exit_ok;

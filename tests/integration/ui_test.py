@@ -257,6 +257,8 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         driver.switch_to.new_window("tab")
         driver.get(ui.url)
         check(wait_until(lambda: "watching" in driver.find_element(By.ID, "role").text), "a second tab watches")
+        check(not driver.find_element(By.CSS_SELECTOR, 'input[data-joint="head_yaw"]').is_enabled() and
+              not driver.find_element(By.ID, "capture").is_enabled(), "its sliders and buttons are disabled")
         driver.close()
         driver.switch_to.window(driver.window_handles[0])
         time.sleep(1.5)  # let the 30 s plots gather a little for the picture

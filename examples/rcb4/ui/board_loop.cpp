@@ -49,7 +49,11 @@ class loop {
     bool lists_sent = false;
     while (!h_.stopped()) {
       const auto start = clock::now();
-      for (auto& a : h_.take()) carry_out(a);
+      for (auto& a : h_.take()) {
+        if (h_.stopped()) return;
+        carry_out(a);
+      }
+      if (h_.stopped()) return;
       poll();
       if (answering_ && !lists_sent) {  // after the first state: a page shows the robot at once
         refresh_lists();
@@ -106,7 +110,7 @@ class loop {
       motion_ = *motion;
       analog_ = *analog;
     }
-    h_.observe(targets_);
+    h_.observe(targets_, angles_, slowest());
     h_.set_state(state_text());
   }
 
@@ -269,14 +273,16 @@ class loop {
           fmt::format("motion {} is running on the board: stop it first (the move would fight it)", *motion_.motion)};
   }
 
+  /** The longest move the board makes: 255 frames of its output period (protocol.md §5). */
+  std::chrono::milliseconds slowest() const { return std::chrono::milliseconds(255 * rcb4::milliseconds(period_)); }
+
   /** Moves @p targets (checked here again: nothing from a page is trusted). */
   json move(std::vector<robot::joint_target> targets) {
     refuse_during_motion();
     // A CONST frame carries 255 frames at most (protocol.md §5): 2.55 s on a 10 ms board. A longer
     // time (a page's, or the speed limit's) becomes the slowest move the board can make.
-    const auto slowest = std::chrono::milliseconds(255 * rcb4::milliseconds(period_));
     for (auto& t : targets)
-      if (t.time && *t.time > slowest) t.time = slowest;
+      if (t.time && *t.time > slowest()) t.time = slowest();
     auto checked = robot::check_targets(m_, targets, 0ms);
     if (!robot::ok(checked)) throw refusal{std::get<robot::problem>(checked).message};
     auto moves = std::get<std::vector<robot::joint_move>>(std::move(checked));
@@ -318,7 +324,8 @@ class loop {
 
   json act(const stop_action& a) {
     json out;
-    if (a.motion && motion_.running) {
+    // The state is read now, not taken from the last poll: a motion started since must stop too.
+    if (a.motion && must(ops::read_motion_state(*o_.layout), "read the motion state").running) {
       must(ops::stop_motion{}, "stop the motion");
       out["motion_stopped"] = true;
     }
@@ -373,13 +380,25 @@ class loop {
     } catch (const std::exception& e) {
       throw refusal{std::string(plain_message(e.what()))};
     }
-    // The slowest joint sets the pace: no joint moves faster than the speed limit.
+    // The farthest joint sets the pace: no joint moves faster than the speed limit.
     double span = 0;
+    std::string farthest;
     for (const auto& [name, d] : p.joints) {
       const auto* j = m_.find(name);
       const auto i = static_cast<std::size_t>(j - m_.joints().data());
-      span = std::max(span, angles_[i] ? std::abs(d - *angles_[i]) : j->upper - j->lower);
+      const double away = angles_[i] ? std::abs(d - *angles_[i]) : j->upper - j->lower;
+      if (away > span) {
+        span = away;
+        farthest = name;
+      }
     }
+    const double speed = h_.limits().max_speed;
+    if (span / speed * 1000 > static_cast<double>(slowest().count()))
+      throw refusal{fmt::format(
+          "{} is {:.0f} degrees from {}: at the speed limit ({} degrees a second) that takes {:.1f} s, longer than "
+          "the slowest move this board makes ({:.2f} s): bring the joint closer first, or raise --speed",
+          farthest, span, a.name, robot::number_text(speed), span / speed,
+          std::chrono::duration<double>(slowest()).count())};
     auto time = a.ms ? std::chrono::milliseconds(*a.ms) : p.time.value_or(h_.limits().default_pose_ms);
     time = std::max(time, paced_time(span, h_.limits()));
     std::vector<robot::joint_target> targets;

@@ -48,7 +48,11 @@ std::chrono::milliseconds paced_time(double degrees, const settings& s) {
 }
 
 controller::controller(const robot::model& m, settings s)
-    : model_(&m), settings_(s), observed_(m.joints().size()), commanded_(m.joints().size()) {}
+    : model_(&m),
+      settings_(s),
+      observed_(m.joints().size()),
+      measured_(m.joints().size()),
+      commanded_(m.joints().size()) {}
 
 std::size_t controller::index_of(const robot::joint* j) const noexcept {
   return static_cast<std::size_t>(j - model_->joints().data());
@@ -214,13 +218,18 @@ void controller::handle(client_id c, const message& m, effects& e) {
       for (const auto* j : std::get<std::vector<const robot::joint*>>(sel))
         if (std::find(joints.begin(), joints.end(), j) == joints.end()) joints.push_back(j);
     }
-    // A freed joint must not be driven again by a slider value still waiting.
-    for (const auto* j : joints) pending_.erase(index_of(j));
+    // A freed joint must not be driven again by a slider value still waiting; a freed or held
+    // joint is where it is now, not where it was last sent.
+    for (const auto* j : joints) {
+      pending_.erase(index_of(j));
+      commanded_[index_of(j)].reset();
+    }
     e.actions.push_back({c, m.id, power_action{p->free, std::move(joints)}});
     return;
   }
   if (std::holds_alternative<stop_request>(m.body)) {
     pending_.clear();
+    for (auto& target : commanded_) target.reset();
     stop_action s;
     for (const auto& j : model_->joints()) s.joints.push_back(&j);
     s.motion = true;
@@ -254,31 +263,49 @@ std::optional<action> controller::due_move(clock::time_point now) {
   if (last_move_ && now - *last_move_ < settings_.move_interval) return std::nullopt;
   move_action mv;
   client_id from = 0;
-  for (const auto& [i, p] : pending_) {
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    const auto i = it->first;
+    const auto& p = it->second;
     const auto& j = model_->joints()[i];
-    // Timed from the farther of what the board shows and what was last sent: never too fast.
+    // Timed from the farthest of what the board shows and what was last sent: never too fast.
     double span = 0;
     bool known = false;
-    for (const auto& from_deg : {observed_[i], commanded_[i]})
+    for (const auto& from_deg : {observed_[i], measured_[i], commanded_[i]})
       if (from_deg) {
         span = std::max(span, std::abs(p.degrees - *from_deg));
         known = true;
       }
-    if (!known) span = j.upper - j.lower;  // nowhere known (free, never read): as if across the whole range
-    auto t = paced_time(span, settings_);
-    if (p.ms) t = std::max(t, std::chrono::milliseconds(*p.ms));
-    mv.targets.push_back({j.name, p.degrees, t});
-    commanded_[i] = p.degrees;
+    if (!known) span = j.upper - j.lower;  // nowhere known (never read): as if across the whole range
+    const auto paced = paced_time(span, settings_);
+    auto t = p.ms ? std::max(paced, std::chrono::milliseconds(*p.ms)) : paced;
+    double degrees = p.degrees;
+    bool arrived = true;
+    const auto start = observed_[i] ? observed_[i] : measured_[i];
+    if (paced > longest_ && start) {
+      // Farther than the board's longest move covers at the speed limit: go part way from where
+      // the board is; the rest follows once this interval is over.
+      const double step = settings_.max_speed * std::chrono::duration<double>(longest_).count();
+      degrees = *start + std::clamp(p.degrees - *start, -step, step);
+      arrived = std::abs(degrees - p.degrees) < 1e-9;
+      t = longest_;
+    } else if (t > longest_) {
+      t = longest_;
+    }
+    mv.targets.push_back({j.name, degrees, t});
+    commanded_[i] = degrees;
     moved_.insert(i);
     from = p.from;
+    it = arrived ? pending_.erase(it) : std::next(it);
   }
-  pending_.clear();
   last_move_ = now;
   return action{from, std::nullopt, std::move(mv)};
 }
 
-void controller::observe(std::span<const std::optional<double>> targets) {
+void controller::observe(std::span<const std::optional<double>> targets, std::span<const std::optional<double>> angles,
+                         std::chrono::milliseconds longest) {
   for (std::size_t i = 0; i < observed_.size() && i < targets.size(); ++i) observed_[i] = targets[i];
+  for (std::size_t i = 0; i < measured_.size() && i < angles.size(); ++i) measured_[i] = angles[i];
+  longest_ = longest;
 }
 
 }  // namespace cli::ui

@@ -116,9 +116,13 @@ class controller {
   std::optional<action> due_move(clock::time_point now);
   /**
    * The board's latest reading, one entry per model joint: the target angle (nothing when free,
-   * held or unknown). Moves are timed from there.
+   * held or unknown) and the measured angle (nothing when silent), and the longest move the
+   * board makes (255 frames of its period). Moves are timed from the farthest of these and the
+   * last target sent; a move that would need longer than @p longest goes part way at the speed
+   * limit, and the rest follows at the next interval.
    */
-  void observe(std::span<const std::optional<double>> targets);
+  void observe(std::span<const std::optional<double>> targets, std::span<const std::optional<double>> angles,
+               std::chrono::milliseconds longest = std::chrono::milliseconds(max_move_ms));
 
   /** The controlling page, if any. */
   std::optional<client_id> controlling() const noexcept { return controller_; }
@@ -148,12 +152,14 @@ class controller {
   settings settings_;
   std::map<client_id, page> pages_;
   std::optional<client_id> controller_;
-  std::map<std::size_t, pending> pending_;        ///< joint index → latest slider target
-  std::vector<std::optional<double>> observed_;   ///< per joint: the board's target
-  std::vector<std::optional<double>> commanded_;  ///< per joint: the last target sent from a page
-  std::set<std::size_t> moved_;                   ///< joints the controlling page moved
-  bool started_motion_ = false;                   ///< the controlling page played a motion
-  std::optional<clock::time_point> last_move_;    ///< when due_move last gave a move
+  std::map<std::size_t, pending> pending_;          ///< joint index → latest slider target
+  std::vector<std::optional<double>> observed_;     ///< per joint: the board's target
+  std::vector<std::optional<double>> measured_;     ///< per joint: the measured angle
+  std::chrono::milliseconds longest_{max_move_ms};  ///< the board's longest move
+  std::vector<std::optional<double>> commanded_;    ///< per joint: the last target sent from a page
+  std::set<std::size_t> moved_;                     ///< joints the controlling page moved
+  bool started_motion_ = false;                     ///< the controlling page played a motion
+  std::optional<clock::time_point> last_move_;      ///< when due_move last gave a move
 };
 
 /** {"type":"error","id":…,"op":…,"message":…} */

@@ -9,6 +9,7 @@
 
 #include "controller.hpp"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -75,10 +76,11 @@ class hub {
     cv_.wait_until(lock, deadline, [&] { return stopped_ || !queue_.empty(); });
     return !stopped_;
   }
-  /** The board's targets, per model joint (see controller::observe). */
-  void observe(std::span<const std::optional<double>> targets) {
+  /** The board's targets and angles, per model joint, and its longest move (see controller::observe). */
+  void observe(std::span<const std::optional<double>> targets, std::span<const std::optional<double>> angles,
+               std::chrono::milliseconds longest) {
     std::lock_guard lock(mutex_);
-    controller_.observe(targets);
+    controller_.observe(targets, angles, longest);
   }
   /** Sends @p text to page @p to. */
   void tell(client_id to, std::string text) { send_(to, std::move(text)); }
@@ -108,7 +110,19 @@ class hub {
   void absorb(effects e, std::vector<letter>& out) {
     for (auto& l : e.letters) out.push_back(std::move(l));
     const bool work = !e.actions.empty();
-    for (auto& a : e.actions) queue_.push_back(std::move(a));
+    for (auto& a : e.actions) {
+      if (std::holds_alternative<stop_action>(a.body)) {  // before anything still waiting
+        queue_.push_front(std::move(a));
+      } else if (std::holds_alternative<refresh_action>(a.body) &&
+                 std::any_of(queue_.begin(), queue_.end(),
+                             [](const action& q) { return std::holds_alternative<refresh_action>(q.body); })) {
+        // One refresh waiting is enough: its lists go to every page.
+      } else if (queue_.size() >= max_queued) {
+        out.push_back({a.from, error_text(a.id, {}, "the board is busy with earlier requests: try again")});
+      } else {
+        queue_.push_back(std::move(a));
+      }
+    }
     if (work) cv_.notify_all();
   }
   void deliver(std::vector<letter>& out) {
@@ -122,6 +136,7 @@ class hub {
     send_(0, std::move(text));
   }
 
+  static constexpr std::size_t max_queued = 32;  ///< actions waiting for the board, at most
   mutable std::mutex mutex_;
   std::condition_variable cv_;
   controller controller_;

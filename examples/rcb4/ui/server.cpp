@@ -285,7 +285,7 @@ class http_session : public std::enable_shared_from_this<http_session> {
     parser_.emplace();
     parser_->header_limit(8 * 1024);
     parser_->body_limit(1024);
-    stream_.expires_after(30s);
+    stream_.expires_after(10s);  // a request's headers within 10 s, or the connection goes
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) { self->on_read(ec); });
   }
@@ -366,8 +366,10 @@ void web_server::stop() {
   stopping_ = true;
   beast::error_code ec;
   acceptor_.close(ec);
+  std::vector<std::shared_ptr<ws_session>> all;
   for (auto& [id, w] : pages_)
-    if (auto s = w.lock()) s->close();
+    if (auto s = w.lock()) all.push_back(std::move(s));
+  for (auto& s : all) s->close();
   for (auto& [owner, closer] : closers_)
     if (!owner.expired()) closer();
   closers_.clear();
@@ -392,8 +394,11 @@ void web_server::deliver(client_id to, const std::string& text) {
       if (auto s = it->second.lock()) s->queue(text);
     return;
   }
+  // queue() may drop a page (too slow), which erases it from pages_: take them out first.
+  std::vector<std::shared_ptr<ws_session>> all;
   for (auto& [id, w] : pages_)
-    if (auto s = w.lock()) s->queue(text);
+    if (auto s = w.lock()) all.push_back(std::move(s));
+  for (auto& s : all) s->queue(text);
 }
 
 client_id web_server::add(std::weak_ptr<ws_session> s) {

@@ -158,7 +158,7 @@ TEST_CASE("ui controller: slider moves are gathered, clamped and paced", "[ui]")
   c.join(1);
   const auto t0 = clock::time_point{} + 1h;
   const std::optional<double> at_zero[] = {0.0, 0.0};
-  c.observe(at_zero);
+  c.observe(at_zero, at_zero);
 
   // Three slider positions before the loop looks: only the last is sent.
   c.receive(1, R"({"op":"move","joints":{"left_knee":10}})", t0);
@@ -292,4 +292,55 @@ TEST_CASE("ui paced_time: at least one move interval, at most the longest move",
   CHECK(paced_time(0, s) == 40ms);
   CHECK(paced_time(-45, s) == 500ms);
   CHECK(paced_time(10000, s) == 6375ms);
+}
+
+TEST_CASE("ui controller: a move longer than the board's longest goes part way at the speed limit", "[ui]") {
+  const auto m = two_joints();
+  controller c(m);  // 90 degrees a second
+  c.join(1);
+  const auto t0 = clock::time_point{} + 1h;
+  const std::optional<double> start[] = {-90.0, 0.0};
+  c.observe(start, start, 2550ms);                                // a 10 ms board: 255 frames
+  c.receive(1, R"({"op":"move","joints":{"head_yaw":90}})", t0);  // 180 degrees: 2 s, fits
+  auto mv = c.due_move(t0);
+  REQUIRE(mv);
+  CHECK(std::get<move_action>(mv->body).targets[0].degrees == 90);
+  CHECK(std::get<move_action>(mv->body).targets[0].time == 2000ms);
+
+  const std::optional<double> far[] = {0.0, -130.0};
+  c.observe(far, far, 2550ms);
+  c.receive(1, R"({"op":"move","joints":{"left_knee":130},"ms":100})", t0 + 1s);  // 260 degrees: 2.9 s
+  mv = c.due_move(t0 + 1s);
+  REQUIRE(mv);
+  const auto& first = std::get<move_action>(mv->body).targets[0];
+  CHECK(first.degrees == Approx(-130 + 229.5));  // 90 degrees a second for 2.55 s
+  CHECK(first.time == 2550ms);
+  // The rest follows from where the board is then.
+  const std::optional<double> later[] = {0.0, 80.0};
+  c.observe(later, later, 2550ms);
+  mv = c.due_move(t0 + 1s + 40ms);
+  REQUIRE(mv);
+  CHECK(std::get<move_action>(mv->body).targets[0].degrees == 130);
+  CHECK(std::get<move_action>(mv->body).targets[0].time == 556ms);  // 50 degrees from 80: ceil(555.6)
+  CHECK(!c.due_move(t0 + 2s));
+}
+
+TEST_CASE("ui controller: after free, a move is timed from the measured angle", "[ui]") {
+  const auto m = two_joints();
+  controller c(m);
+  c.join(1);
+  const auto t0 = clock::time_point{} + 1h;
+  const std::optional<double> zero[] = {0.0, 0.0};
+  c.observe(zero, zero);
+  c.receive(1, R"({"op":"move","joints":{"head_yaw":0}})", t0);
+  REQUIRE(c.due_move(t0));
+  c.receive(1, R"({"op":"free","joints":["head_yaw"]})", t0);
+  // Moved by hand to 80 while free: the board shows no target, the measured angle 80.
+  const std::optional<double> targets[] = {std::nullopt, 0.0};
+  const std::optional<double> angles[] = {80.0, 0.0};
+  c.observe(targets, angles);
+  c.receive(1, R"({"op":"move","joints":{"head_yaw":1}})", t0 + 1s);
+  const auto mv = c.due_move(t0 + 1s);
+  REQUIRE(mv);
+  CHECK(std::get<move_action>(mv->body).targets[0].time == 878ms);  // 79 degrees, not 1
 }

@@ -21,6 +21,7 @@ const ui = {
   ws: null,
   hello: null,
   role: 'view',
+  controlled: false,
   rows: new Map(),       // joint name → {row, slider, angle, target, marker, j, index}
   dragging: new Map(),   // joint name → time the page last moved its slider
   sendTimer: null,
@@ -142,6 +143,7 @@ function buildJoints(h) {
     box.append(card);
   }
   if (bar.childElementCount > 1) box.append(bar);
+  setRole(ui.role, ui.controlled);
 }
 
 function jointRow(j) {
@@ -161,6 +163,11 @@ function jointRow(j) {
       el('button', { type: 'button', title: 'torque on where it is', onclick: () => send({ op: 'hold', joints: [j.name] }) }, 'hold')),
     el('span', { class: 'target-line' }, target),
     el('div', { class: 'limits' }, el('span', { text: `${j.lower}°` }), el('span', { text: `${j.upper}°` })));
+  // While the pointer holds the slider it is the person's; otherwise it follows the board.
+  slider.addEventListener('pointerdown', () => { ui.rows.get(j.name).held = true; });
+  const letGo = () => { ui.rows.get(j.name).held = false; ui.dragging.set(j.name, performance.now()); };
+  slider.addEventListener('pointerup', letGo);
+  slider.addEventListener('pointercancel', letGo);
   slider.addEventListener('input', () => {
     ui.dragging.set(j.name, performance.now());
     ui.pendingMoves[j.name] = Number(slider.value);
@@ -198,10 +205,12 @@ function renderState(s) {
     const t = s.targets[i];
     const moved = ui.dragging.get(j.name);
     const recent = moved !== undefined && now - moved < 800;
-    if (!recent) {
+    if (!recent && !r.held) {
       r.target.textContent = mode === 'free' ? 'free' : mode === 'hold' ? 'hold' : t === null ? '' : `target ${fmtDeg(t)}`;
       r.target.dataset.degrees = t === null ? '' : String(t);
-      if (t !== null && document.activeElement !== r.slider) r.slider.value = t;
+      // A free or held joint has no target: its slider shows where the joint is.
+      const follow = t !== null ? t : s.angles[i];
+      if (follow !== null) r.slider.value = follow;
     }
   });
   renderLink(s);
@@ -226,10 +235,14 @@ function renderLink(s) {
 
 function setRole(role, controlled) {
   ui.role = role;
+  ui.controlled = controlled;
   document.body.classList.toggle('view', role !== 'control');
   const badge = $('#role');
   badge.textContent = role === 'control' ? 'controlling' : controlled ? 'watching (another page controls)' : 'watching';
   badge.className = 'badge' + (role === 'control' ? ' control' : '');
+  // Watching: the controls are disabled (keyboard too), not only dimmed.
+  for (const e of document.querySelectorAll('.needs-control, .joint input, .joint .power button'))
+    e.disabled = role !== 'control';
   const b = $('#control');
   b.textContent = role === 'control' ? 'Release' : 'Take control';
   b.disabled = role !== 'control' && controlled;
@@ -244,6 +257,7 @@ function renderPoses(poses, dir) {
     el('button', { type: 'button', class: 'play needs-control', onclick: () => playPose(p) }, 'Play'))));
   if (!poses.length) list.append(el('li', { class: 'muted', text: 'no pose saved yet' }));
   $('#poses-dir').textContent = dir ? `saved in ${dir}` : '';
+  setRole(ui.role, ui.controlled);
 }
 
 function playPose(name) {
@@ -257,6 +271,7 @@ function renderMotions() {
     el('span', { text: `${m.slot} ${m.name ?? ''}`.trim() + (m.readable ? '' : ' (unreadable)') }),
     el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'motion_play', slot: m.slot }) }, 'Play'))));
   if (!ui.motions.length) list.append(el('li', { class: 'muted', text: 'no motion in ROM' }));
+  setRole(ui.role, ui.controlled);
 }
 
 function renderMotion(m) {
