@@ -157,8 +157,14 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     a.send_text("x" * 20000)
     check(closed_within(a, 5), "a message over 16 KiB closes that page's socket")
     # The controller went with it: a second page may take control; then it vanishes mid-move.
-    b.send({"op": "control", "id": 1})
-    check(b.wait_for(lambda m: m["type"] == "reply" and m["id"] == 1) is not None, "the watcher takes control once free")
+    took = None
+    for attempt in range(30):  # the server learns of the closed page a moment after the client does
+        b.send({"op": "control", "id": 100 + attempt})
+        took = b.wait_for(lambda m: m["type"] in ("reply", "error") and m.get("id") == 100 + attempt)
+        if took and took["type"] == "reply":
+            break
+        time.sleep(0.1)
+    check(took is not None and took["type"] == "reply", "the watcher takes control once free")
     knee = names.index("left_knee")
     b.send({"op": "move", "joints": {"left_knee": 120}, "ms": 6000})  # 2.55 s: the slowest a 10 ms board moves
     moving = b.wait_for(lambda m: m["type"] == "state" and m["targets"][knee] is not None and m["targets"][knee] > 3)
@@ -192,6 +198,37 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     check(WebSocket(ui.port, path="/ws?token=" + token, host=f"robot.lan:{ui.port}",
                     origin="http://evil.example").status == 403, "with it but from a foreign Origin: 403")
     check(ui.stop() == 0, "stopped")
+
+    # --- boards that are not ours: a partial one, one that dies ---------------------------------
+    standin = os.path.join(os.path.dirname(os.path.abspath(__file__)), "standin.py")
+    for mode in ("partial", "die"):
+        sp = subprocess.Popen([sys.executable, standin] + (["--mode", "die"] if mode == "die" else []),
+                              stdout=subprocess.PIPE, text=True)
+        try:
+            sdev = sp.stdout.readline().strip()
+            ui = Ui("--device", sdev, "--baud", "115200", "ui", "--listen", "127.0.0.1:0", "--poses", poses)
+            w = WebSocket(ui.port)
+            if mode == "partial":  # ICS 0-2 allocated: three joints, seventeen without a servo
+                st = w.wait_for(lambda m: m["type"] == "state" and m["answering"], timeout=10)
+                modes = st["modes"] if st else []
+                check(modes[:3] == ["on"] * 3 and modes[3:] == ["missing"] * 17,
+                      f"a board with 3 of 20 servos: those 3 shown, the others 'missing' ({modes[:5]}...)")
+                w.send({"op": "move", "id": 2, "joints": {"left_knee": 10}})
+                e = w.wait_for(lambda m: m["type"] in ("error", "reply") and m["op"] == "move", timeout=5)
+                check(e and e["type"] == "error" and "left_knee: the board has no servo block" in e["message"],
+                      f"moving a joint it lacks: an error naming it ({e})")
+            else:
+                st = w.wait_for(lambda m: m["type"] == "state" and not m["answering"], timeout=15)
+                check(st is not None and st["error"] and "reading the robot" in st["error"],
+                      f"a board that stops answering: shown as such, with the reason ({st and st['error']})")
+                check(st is not None and all(a is None for a in st["angles"]), "and no stale angles")
+            w.close()
+            t = time.time()
+            rc = ui.stop()
+            check(rc == 0 and time.time() - t < 5, f"SIGINT with that board: exit 0 at once ({rc}, {time.time() - t:.1f} s)")
+        finally:
+            sp.kill()
+            sp.wait()
 
     # --- the page in a real browser -------------------------------------------------------------
     try:

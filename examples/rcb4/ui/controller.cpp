@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace cli::ui {
 namespace {
@@ -195,7 +196,7 @@ void controller::handle(client_id c, const message& m, effects& e) {
                           robot::number_text(d));
       accepted.emplace_back(i, d);
     }
-    for (const auto& [i, d] : accepted) pending_[i] = {d, mv->ms, c};
+    for (const auto& [i, d] : accepted) pending_[i] = {d, mv->ms, c, m.id};
     if (!clamped.empty()) {
       json n;
       n["type"] = "note";
@@ -204,7 +205,7 @@ void controller::handle(client_id c, const message& m, effects& e) {
       n["clamped"] = clamped;
       e.letters.push_back({c, dump(n)});
     }
-    if (m.id) e.letters.push_back({c, reply_text(m.id, op)});
+    // A move with an id is answered by the board loop once sent (or refused there).
     return;
   }
   if (const auto* p = std::get_if<power_request>(&m.body)) {
@@ -263,6 +264,7 @@ std::optional<action> controller::due_move(clock::time_point now) {
   if (last_move_ && now - *last_move_ < settings_.move_interval) return std::nullopt;
   move_action mv;
   client_id from = 0;
+  std::optional<std::int64_t> id;
   for (auto it = pending_.begin(); it != pending_.end();) {
     const auto i = it->first;
     const auto& p = it->second;
@@ -295,10 +297,11 @@ std::optional<action> controller::due_move(clock::time_point now) {
     commanded_[i] = degrees;
     moved_.insert(i);
     from = p.from;
+    if (p.id) id = std::exchange(it->second.id, std::nullopt);
     it = arrived ? pending_.erase(it) : std::next(it);
   }
   last_move_ = now;
-  return action{from, std::nullopt, std::move(mv)};
+  return action{from, id, std::move(mv)};
 }
 
 void controller::observe(std::span<const std::optional<double>> targets, std::span<const std::optional<double>> angles,

@@ -141,6 +141,7 @@ class controller {
     double degrees = 0;
     std::optional<int> ms;
     client_id from = 0;
+    std::optional<std::int64_t> id;  ///< the page's id, answered once this move is sent
   };
   letter role_letter(client_id c) const;
   void roles_to_all(effects& e) const;
