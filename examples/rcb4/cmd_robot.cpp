@@ -492,6 +492,8 @@ void add_trim(CLI::App& app, context& ctx) {
         if (t.time) throw usage_error(fmt::format("{}: a trim has no duration (@MS)", t.joint));
         const auto* j = m.find(t.joint);
         if (!j) throw usage_error(fmt::format("no joint is called '{}' (see rcb4 joint list)", t.joint));
+        if (std::any_of(trims.begin(), trims.end(), [&](const robot::joint_trim& x) { return x.j == j; }))
+          throw usage_error(fmt::format("{} is given twice", t.joint));
         auto tr = robot::trim_of(*j, t.degrees);
         if (!robot::ok(tr)) throw usage_error(std::get<robot::problem>(tr).message);
         trims.push_back(std::get<robot::joint_trim>(tr));

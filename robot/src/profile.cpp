@@ -5,6 +5,8 @@
 #include <yaml-cpp/yaml.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -206,7 +208,13 @@ pose parse_pose_nodes(std::string_view text, const std::string& source, const mo
   if (root["robot"]) {
     p.robot = scalar(source, root["robot"], "robot");
     // Another robot's pose may name the same joints with other zeros, directions and limits.
-    if (p.robot != m.name())
+    // Names compare without case: "khr-3hv" (the built-in's name) is KHR-3HV.
+    const auto same = [](std::string_view a, std::string_view b) {
+      return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+               return std::tolower(static_cast<unsigned char>(x)) == std::tolower(static_cast<unsigned char>(y));
+             });
+    };
+    if (!same(p.robot, m.name()))
       fail(source, root["robot"],
            "this pose is " + p.robot + "'s, not " + m.name() + "'s (--robot names the profile it was captured with)");
   }

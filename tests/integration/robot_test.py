@@ -104,6 +104,8 @@ with serve() as dev:
 
     rc, out, err = run(*on, "trim", "set", "left_knee=1.5", "--persist")
     check(rc == 0 and "+44 counts" in out, f"trim set --persist ({out.strip()!r})")
+    rc, out, err = run(*on, "trim", "set", "left_knee=1", "left_knee=2")
+    check(rc == 2 and "left_knee is given twice" in err, f"trim set of one joint twice: exit 2 ({rc}, {err.strip()!r})")
     rc, out, err = run("--json", *on, "trim", "get", "left_knee")
     t = json.loads(out)[0] if rc == 0 else {}
     check(t.get("counts") == 44 and abs(t.get("degrees", 0) - 1.49) < 0.01, f"trim get reads it back ({t})")

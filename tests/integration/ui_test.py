@@ -182,6 +182,25 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     knee_deg = joints_on(dev)["left_knee"]["degrees"]
     check(knee_deg is not None and 3 < knee_deg < 100, f"the knee stopped part way ({knee_deg})")
 
+    # --- a ROM motion: its progress, and stopped part way ----------------------------------------
+    ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
+    w = WebSocket(ui.port)
+    lists = w.wait_for(lambda m: m["type"] == "lists", timeout=10)
+    check(lists is not None and [m["slot"] for m in lists["motions"]] == [1, 2, 3] and lists["motions"][1]["name"] == "wave",
+          f"the motion list with the profile's names ({lists and lists['motions']})")
+    w.send({"op": "motion_play", "id": 3, "slot": 2})
+    st = w.wait_for(lambda m: m["type"] == "state" and m["motion"]["slot"] == 2 and
+                    (m["motion"]["progress"] or 0) > 0.05, timeout=10)
+    check(st is not None and st["motion"]["running"] and 0 < st["motion"]["progress"] < 1,
+          f"motion 2 plays, with how far it has got ({st and st['motion']})")
+    w.send({"op": "motion_stop", "id": 4})
+    st = w.wait_for(lambda m: m["type"] == "state" and m["motion"]["suspended"], timeout=5)
+    check(st is not None, "motion_stop: the state says stopped part way, not running")
+    w.close()
+    check(ui.stop() == 0, "stopped")
+    run("--device", dev, "motion", "resume")
+    run("--device", dev, "motion", "wait", "--timeout", "10")
+
     # --- a token for other addresses ----------------------------------------------------------
     ui = Ui("--device", dev, "ui", "--listen", "0.0.0.0:0", "--poses", poses)
     token = re.search(r"\?token=([0-9a-f]{32})$", ui.url)

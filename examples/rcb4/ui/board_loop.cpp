@@ -159,6 +159,8 @@ class loop {
     mo["running"] = motion_.running;
     mo["slot"] = motion_.motion ? json(*motion_.motion) : json(nullptr);
     mo["rom_program"] = rom_program_;
+    // A CALL still pending with the program switched off: stopped part way (motion_stop).
+    mo["suspended"] = motion_.running && !rom_program_;
     mo["progress"] = nullptr;
     if (motion_.motion)
       for (const auto& v : motions_)

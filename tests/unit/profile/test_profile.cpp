@@ -144,6 +144,8 @@ TEST_CASE("profile: poses in JSON and YAML, written and read back", "[profile]")
   // Another robot's pose is refused, naming both.
   CHECK_THROWS_WITH(parse_pose("robot: KXR-L2\njoints: {left_knee: 10}\n", "p.yaml", m),
                     "p.yaml:1:8: this pose is KXR-L2's, not test's (--robot names the profile it was captured with)");
+  // The same robot in other letters is the same robot.
+  CHECK(parse_pose("robot: TEST\njoints: {left_knee: 10}\n", "p.yaml", m).joints.size() == 1);
 }
 
 TEST_CASE("profile: YAML poses carry hundredths, not float noise", "[profile]") {

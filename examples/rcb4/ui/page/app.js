@@ -275,12 +275,13 @@ function renderMotions() {
 }
 
 function renderMotion(m) {
-  const text = m.running ? (m.slot ? `motion ${m.slot} running` : 'the ROM program runs outside the motion slots')
-                         : 'no motion running';
+  const text = m.suspended ? (m.slot ? `motion ${m.slot} stopped part way` : 'the ROM program is stopped')
+    : m.running ? (m.slot ? `motion ${m.slot} running` : 'the ROM program runs outside the motion slots')
+    : 'no motion running';
   $('#motion-state').textContent = text;
   $('#motion-progress').value = m.progress ?? 0;
   for (const li of document.querySelectorAll('#motions li[data-motion]'))
-    li.classList.toggle('running', m.running && String(m.slot) === li.dataset.motion);
+    li.classList.toggle('running', m.running && !m.suspended && String(m.slot) === li.dataset.motion);
 }
 
 // --- sensors -----------------------------------------------------------------------------------------
