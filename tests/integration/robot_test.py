@@ -191,6 +191,9 @@ with serve("--servos", "4") as dev:
           f"scan on a 4-slot board names the joints without a slot ({out.strip().splitlines()[-1]!r})")
     rc, out, err = run("--device", dev, "joint", "move", "left_knee=10")
     check(rc == 1 and "no servo allocated for left_knee (ICS 16)" in err, f"moving a joint the board lacks: exit 1 ({err.strip()!r})")
+    rc, out, err = run("--device", dev, "trim", "set", "left_knee=1")
+    check(rc == 1 and "no servo allocated for left_knee (ICS 16): nothing written" in err,
+          f"trimming a joint the board lacks: exit 1 naming it ({err.strip()!r})")
     rc, out, err = run("--json", "--device", dev, "joint", "list")
     js = {j["name"]: j for j in json.loads(out)} if rc == 0 else {}
     check(rc == 0 and js["head_yaw"]["allocated"] and not js["left_knee"]["allocated"] and js["left_knee"]["degrees"] is None,
