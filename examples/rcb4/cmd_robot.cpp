@@ -514,11 +514,10 @@ void add_trim(CLI::App& app, context& ctx) {
       }
       if (ec == rcb4::errc::servo_not_allocated && op.unallocated()) {
         const auto* j = op.unallocated();
-        throw failure(exit_board,
-                      fmt::format("the board has no servo allocated for {} (ICS {}): nothing written", j->name,
-                                  j->ics.value()),
-                      fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot",
-                                  m.name()));
+        throw failure(
+            exit_board,
+            fmt::format("the board has no servo allocated for {} (ICS {}): nothing written", j->name, j->ics.value()),
+            fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
       }
       if (ec) throw rcb4::transport::system_error(ec);
       const auto& done = op.value();
