@@ -98,6 +98,12 @@ TEST_CASE("robot ops: a servo that never answered has no angle", "[robot]") {
   CHECK_FALSE(knee.answered());
   CHECK_FALSE(knee.degrees().has_value());  // not -253 degrees
   CHECK(rd.value()[0].degrees().value() == Approx(0.0));
+  // A block the board never drove reads a target of 0: no angle either.
+  joint_reading never = knee;
+  never.target = 0;
+  CHECK_FALSE(never.target_degrees().has_value());
+  never.target = 7500;
+  CHECK(never.target_degrees().has_value());  // the centre is an angle (the joint's offset decides which)
 }
 
 TEST_CASE("robot ops: a move becomes CONST frames timed by the board's output period", "[robot]") {

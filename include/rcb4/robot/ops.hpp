@@ -116,8 +116,13 @@ struct joint_reading {
   bool answered() const noexcept { return allocated && position != 0; }
   /** The joint's angle, from the measured position; nothing when unallocated, silent or not an angle. */
   std::optional<double> degrees() const { return answered() ? to_degrees(*j, position) : std::nullopt; }
-  /** The target's angle; nothing when free, held, unallocated or not read. */
-  std::optional<double> target_degrees() const { return allocated ? to_degrees(*j, target) : std::nullopt; }
+  /**
+   * The target's angle; nothing when free, held, unallocated, not read, or 0 (a block the board
+   * never drove: no servo position is 0, so it is not an angle of -253 degrees).
+   */
+  std::optional<double> target_degrees() const {
+    return allocated && target != 0 ? to_degrees(*j, target) : std::nullopt;
+  }
   /** True when the output is FREE (no torque). */
   bool is_free() const noexcept { return allocated && target == servo_position::free_value; }
   /** True when the output is HOLD. */
