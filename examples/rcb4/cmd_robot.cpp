@@ -108,9 +108,13 @@ sent_moves move(session& s, const robot::model& m, std::vector<robot::joint_move
   robot::move_joints op(std::move(moves));
   rcb4::transport::error_code ec;
   s.run_steps(op, ec, [] {});
+  // Possible on a board with a longer period (25 ms: 6375 ms), so the board's limit (exit 1), not a typo (2).
   if (ec == rcb4::errc::frames_out_of_range)
-    throw usage_error(fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period",
-                                  255 * milliseconds(op.period()), milliseconds(op.period())));
+    throw failure(exit_board,
+                  fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period; nothing "
+                              "was sent",
+                              255 * milliseconds(op.period()), milliseconds(op.period())),
+                  "a shorter time, or a longer period: rcb4 config set period=25");
   if (ec) throw rcb4::transport::system_error(ec);
   auto done = op.value();
   if (wait) {

@@ -104,6 +104,9 @@ with serve() as dev:
 
     rc, out, err = run(*on, "trim", "set", "left_knee=1.5", "--persist")
     check(rc == 0 and "+44 counts" in out, f"trim set --persist ({out.strip()!r})")
+    rc, out, err = run(*on, "joint", "move", "left_knee=10@6000")
+    check(rc == 1 and "2550 ms at this board's 10 ms period; nothing was sent" in err,
+          f"a move longer than this board's 255 frames: exit 1, the board's limit ({rc}, {err.strip()!r})")
     rc, out, err = run(*on, "trim", "set", "left_knee=1", "left_knee=2")
     check(rc == 2 and "left_knee is given twice" in err, f"trim set of one joint twice: exit 2 ({rc}, {err.strip()!r})")
     rc, out, err = run("--json", *on, "trim", "get", "left_knee")
