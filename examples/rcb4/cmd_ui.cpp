@@ -7,7 +7,9 @@
 #include <boost/asio/ip/host_name.hpp>
 #include <boost/asio/signal_set.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <random>
 #include <thread>
 
@@ -58,7 +60,17 @@ std::string url_of(const boost::asio::ip::tcp::endpoint& ep, const std::string& 
   return fmt::format("http://{}:{}/{}", host, ep.port(), token.empty() ? "" : "?token=" + token);
 }
 
-int run_ui(context& ctx, const ui_options& o) {
+int run_ui(context& ctx, const ui_options& o, bool token_given) {
+  // NaN passes a range check (every comparison is false): it would switch the speed limit off.
+  if (!(o.speed >= 1 && o.speed <= 1000)) throw usage_error("--speed: degrees per second, 1 to 1000");
+  if (token_given && o.token.size() < 16)
+    throw usage_error("--token: at least 16 letters or digits (it is the only lock on a network address)");
+  {
+    std::error_code ec;
+    if (o.poses.empty()) throw usage_error("--poses: an empty folder name");
+    if (std::filesystem::exists(o.poses, ec) && !std::filesystem::is_directory(o.poses, ec))
+      throw usage_error(fmt::format("--poses {}: not a folder", o.poses));
+  }
   const auto& m = robot_of(ctx.g);
   ui::server_options so;
   so.listen = endpoint_of(o.listen);
@@ -159,7 +171,11 @@ void add_ui_command(CLI::App& app, context& ctx) {
       "Prints the URL as the first line of stdout and serves until SIGINT/SIGTERM (exit 0).\n"
       "Open it in a browser on this machine, or from another one over SSH:\n"
       "  ssh -L 8080:127.0.0.1:8080 robot-pc   then http://127.0.0.1:8080/ on yours");
-  cmd->callback([&ctx, o] { ctx.action = [&ctx, o] { return run_ui(ctx, *o); }; });
+  auto* token = cmd->get_option("--token");
+  cmd->callback([&ctx, o, token] {
+    const bool token_given = token->count() > 0;
+    ctx.action = [&ctx, o, token_given] { return run_ui(ctx, *o, token_given); };
+  });
 }
 
 }  // namespace cli

@@ -104,6 +104,11 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     # --- the command line and HTTP ---------------------------------------------------------
     rc, out, err = run("ui", "--listen", "nonsense")
     check(rc == 2 and "--listen: expected HOST:PORT" in err, f"ui --listen nonsense: exit 2 ({rc}, {err.strip()!r})")
+    for bad, why in ((["--speed", "nan"], "--speed: degrees per second, 1 to 1000"),
+                     (["--listen", "0.0.0.0:0", "--token", "short"], "--token: at least 16"),
+                     (["--poses", os.path.abspath(__file__)], "not a folder")):
+        rc, out, err = run("ui", *bad)
+        check(rc == 2 and why in err, f"ui {' '.join(bad)}: exit 2 ({rc}, {err.strip()!r})")
     ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
     check(ui.port > 0 and ui.url == f"http://127.0.0.1:{ui.port}/", f"the URL is the first line of stdout ({ui.url!r})")
     busy = subprocess.run([RCB4, "ui", "--listen", f"127.0.0.1:{ui.port}"], capture_output=True, text=True, timeout=30)

@@ -186,7 +186,7 @@ class loop {
     for (auto it = std::filesystem::directory_iterator(o_.poses, ec);
          !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
       const auto& p = it->path();
-      if (!(p.extension() == ".yaml" || p.extension() == ".json")) continue;
+      if (!(p.extension() == ".yaml" || p.extension() == ".json") || !it->is_regular_file(ec)) continue;
       const auto stem = p.stem().string();
       if (valid_pose_name(stem) && std::find(out.begin(), out.end(), stem) == out.end()) out.push_back(stem);
     }
@@ -324,15 +324,37 @@ class loop {
     return json{{"joints", a.joints.size() - missing.size()}, {"missing", missing}};
   }
 
+  /** Runs @p make()'s operation up to three times (a stop must get through a lossy line). */
+  template <class Make>
+  void insist(Make make, std::string_view what) {
+    for (int attempt = 1;; ++attempt) {
+      try {
+        must(make(), what);
+        return;
+      } catch (const refusal&) {
+        if (attempt == 3) throw;
+      }
+    }
+  }
+
   json act(const stop_action& a) {
     json out;
     // The state is read now, not taken from the last poll: a motion started since must stop too.
-    if (a.motion && must(ops::read_motion_state(*o_.layout), "read the motion state").running) {
-      must(ops::stop_motion{}, "stop the motion");
-      out["motion_stopped"] = true;
+    // Stopping it comes first (it would drive the joints again), then the hold.
+    if (a.motion) {
+      bool running = true;
+      try {
+        running = must(ops::read_motion_state(*o_.layout), "read the motion state").running;
+      } catch (const refusal&) {
+        // Unknown: stop it anyway.
+      }
+      if (running) {
+        insist([] { return ops::stop_motion{}; }, "stop the motion");
+        out["motion_stopped"] = true;
+      }
     }
     const auto mask = mask_of(a.joints, nullptr);
-    if (!mask.empty()) must(ops::set_servo_power(ops::power_state::hold, mask), "hold");
+    if (!mask.empty()) insist([&] { return ops::set_servo_power(ops::power_state::hold, mask); }, "hold");
     out["held"] = a.joints.size();
     return out;
   }
@@ -340,9 +362,11 @@ class loop {
   std::filesystem::path pose_path(const std::string& name, bool for_reading) const {
     const auto yaml = o_.poses / (name + ".yaml");
     if (!for_reading) return yaml;
-    t::error_code ec;
-    if (std::filesystem::exists(yaml, ec)) return yaml;
-    return o_.poses / (name + ".json");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(yaml, ec)) return yaml;
+    const auto json_file = o_.poses / (name + ".json");
+    if (std::filesystem::is_regular_file(json_file, ec)) return json_file;
+    throw refusal{fmt::format("no pose called '{}' in {} (NAME.yaml or NAME.json)", name, o_.poses.string())};
   }
 
   json act(const capture_action& a) {
@@ -402,6 +426,10 @@ class loop {
           farthest, span, a.name, robot::number_text(speed), span / speed,
           std::chrono::duration<double>(slowest()).count())};
     auto time = a.ms ? std::chrono::milliseconds(*a.ms) : p.time.value_or(h_.limits().default_pose_ms);
+    if (time > slowest())
+      throw refusal{
+          fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period, not {} ms",
+                      slowest().count(), rcb4::milliseconds(period_), time.count())};
     time = std::max(time, paced_time(span, h_.limits()));
     std::vector<robot::joint_target> targets;
     for (const auto& [name, d] : p.joints) targets.push_back({name, d, time});

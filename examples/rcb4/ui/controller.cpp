@@ -128,8 +128,11 @@ bool controller::admit(client_id c, clock::time_point now, effects& e) {
 effects controller::receive(client_id c, std::string_view text, clock::time_point now) {
   effects e;
   if (!pages_.count(c)) return e;
-  if (!admit(c, now, e)) return e;
   auto parsed = parse_message(text);
+  // Stop is never dropped by the rate limit: it is what a flooded robot needs most.
+  const auto* msg = std::get_if<message>(&parsed);
+  const bool stop = msg && std::holds_alternative<stop_request>(msg->body);
+  if (!stop && !admit(c, now, e)) return e;
   if (auto* bad = std::get_if<parse_error>(&parsed)) {
     e.letters.push_back({c, error_text(bad->id, {}, bad->what)});
     return e;

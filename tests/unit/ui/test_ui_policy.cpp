@@ -271,6 +271,11 @@ TEST_CASE("ui controller: a page that floods is slowed, then heard again", "[ui]
   CHECK(refused == 1);                                                 // told once, not once per message
   const auto later = c.receive(1, R"({"op":"refresh"})", t0 + 200ms);  // 2 tokens back
   CHECK(later.actions.size() == 1);
+  // Stop is never dropped: a flooded robot needs it most.
+  for (int i = 0; i < 20; ++i) c.receive(1, R"({"op":"move","joints":{"left_knee":1}})", t0 + 200ms);
+  const auto stop = c.receive(1, R"({"op":"stop","id":999})", t0 + 200ms);
+  REQUIRE(stop.actions.size() == 1);
+  CHECK(std::holds_alternative<stop_action>(stop.actions[0].body));
 }
 
 TEST_CASE("ui controller: malformed text gets an error, never an action", "[ui]") {
