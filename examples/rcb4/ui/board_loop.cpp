@@ -378,11 +378,17 @@ class loop {
     auto rs =
         must(robot::read_joints(map_, robot::fields::positions, ops::link_cost::at(s_.baud(), 1ms)), "read the joints");
     robot::pose p{m_.name(), {}, std::nullopt};
-    std::vector<std::string> left_out;
+    std::vector<std::string> left_out, clamped;
     for (const auto& r : rs) {
       if (const auto d = r.degrees()) {
-        // Hundredths, within the limits: a servo a hair beyond must not make the pose unplayable.
-        p.joints.emplace_back(r.j->name, std::clamp(std::round(*d * 100) / 100, r.j->lower, r.j->upper));
+        // Hundredths, within the limits, so that the pose can be played; a joint beyond them (a
+        // motion can put it there) is named in the answer.
+        const double h = std::round(*d * 100) / 100;
+        const double within = std::clamp(h, r.j->lower, r.j->upper);
+        if (std::abs(within - h) >= 0.05)
+          clamped.push_back(
+              fmt::format("{} {} (at {:.1f}, beyond its limit)", r.j->name, robot::number_text(within), h));
+        p.joints.emplace_back(r.j->name, within);
       } else {
         left_out.push_back(r.j->name);
       }
@@ -395,7 +401,11 @@ class loop {
       throw refusal{fmt::format("cannot save {}: {}", path.string(), plain_message(e.what()))};
     }
     refresh_lists();
-    return json{{"name", a.name}, {"file", path.string()}, {"joints", p.joints.size()}, {"left_out", left_out}};
+    return json{{"name", a.name},
+                {"file", path.string()},
+                {"joints", p.joints.size()},
+                {"left_out", left_out},
+                {"clamped", clamped}};
   }
 
   json act(const play_pose_action& a) {

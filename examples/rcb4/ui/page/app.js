@@ -88,7 +88,8 @@ const on = {
   },
   reply(m) {
     const what = {
-      capture: () => `captured ${m.joints} joints as ${m.name}` + (m.left_out?.length ? ` (left out: ${m.left_out.join(', ')})` : ''),
+      capture: () => `captured ${m.joints} joints as ${m.name}` + (m.left_out?.length ? ` (left out: ${m.left_out.join(', ')})` : '') +
+        (m.clamped?.length ? ` (saved at the limit: ${m.clamped.join(', ')})` : ''),
       play_pose: () => `playing ${m.name} over ${m.ms} ms`,
       motion_play: () => `playing motion ${m.slot}`,
       motion_stop: () => 'motion stopped',
@@ -228,7 +229,9 @@ function setLink(ok, text) {
 function renderLink(s) {
   const l = ui.hello.link;
   const where = `${l.device}${l.baud ? ` · ${l.baud} baud` : ''}`;
-  const counts = `${s.link.per_second.toFixed(0)} exchanges/s · ${s.link.errors} errors`;
+  const n = (k, word) => `${k} ${word}${k === 1 ? '' : 's'}`;
+  const counts = `${s.link.per_second.toFixed(0)} exchanges/s · ${n(s.link.errors, 'error')}` +
+    (s.link.timeouts ? ` · ${n(s.link.timeouts, 'timeout')}` : '');
   setLink(s.answering, s.answering ? `${where} · ${counts}` : `${where} · board not answering: ${s.error}`);
   $('#link').dataset.answering = String(s.answering);
 }
