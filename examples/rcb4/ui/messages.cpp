@@ -98,26 +98,17 @@ const json& required(const json& o, std::string_view op, std::string_view key) {
 }
 
 request body_of(const json& o, const std::string& op) {
-  if (op == "control") {
-    only_keys(o, op, {"op", "id"});
-    return take_control{};
-  }
-  if (op == "release") {
-    only_keys(o, op, {"op", "id"});
-    return release_control{};
-  }
-  if (op == "stop") {
-    only_keys(o, op, {"op", "id"});
-    return stop_request{};
-  }
-  if (op == "motion_stop") {
-    only_keys(o, op, {"op", "id"});
-    return motion_stop_request{};
-  }
-  if (op == "refresh") {
-    only_keys(o, op, {"op", "id"});
-    return refresh_request{};
-  }
+  // The ops without fields of their own.
+  const std::pair<std::string_view, request> bare[] = {{"control", take_control{}},
+                                                       {"release", release_control{}},
+                                                       {"stop", stop_request{}},
+                                                       {"motion_stop", motion_stop_request{}},
+                                                       {"refresh", refresh_request{}}};
+  for (const auto& [name, r] : bare)
+    if (op == name) {
+      only_keys(o, op, {"op", "id"});
+      return r;
+    }
   if (op == "move") {
     only_keys(o, op, {"op", "id", "joints", "ms"});
     const auto& js = required(o, op, "joints");
