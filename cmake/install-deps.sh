@@ -11,7 +11,8 @@ packages=(
   libboost1.81-dev                     # Boost.Asio for transport/ (1.74's Asio breaks under GCC 12 in C++20)
   libcli11-dev nlohmann-json3-dev      # the rcb4 tool's arguments and JSON
   libyaml-cpp-dev                      # robot profiles and pose files (rcb4::profile)
-  gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib  # firmware cross-compile check of the codec
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # the codec built for firmware
+  qemu-system-arm                      # runs the example firmware (examples/firmware) in the suite
   python3                              # a client in another language for the virtual board tests
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)

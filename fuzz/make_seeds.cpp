@@ -1,4 +1,6 @@
-// Writes the golden frames (tests/support/golden.hpp) as fuzz seeds: fuzz/seeds/{command,reply}/.
+// Writes the golden frames (tests/support/golden.hpp) as fuzz seeds: fuzz/seeds/{command,reply}/
+// (with the harnesses' option bytes first) and fuzz/seeds/frames/ (the reply frames alone, for
+// the template a user copies to fuzz their own wrapper).
 // Run by hand when the golden table grows: make_seeds <fuzz/seeds directory>.
 // SPDX-License-Identifier: BSL-1.0
 #include "golden.hpp"
@@ -24,6 +26,7 @@ int main(int argc, char** argv) {
   const std::filesystem::path dir(argv[1]);
   std::filesystem::create_directories(dir / "command");
   std::filesystem::create_directories(dir / "reply");
+  std::filesystem::create_directories(dir / "frames");
   int i = 0;
   for (const auto& g : rcb4::golden::requests) {
     const std::uint8_t opt[] = {
@@ -34,7 +37,8 @@ int main(int argc, char** argv) {
   for (const auto& g : rcb4::golden::replies) {
     const std::uint8_t hdr[] = {g.expected.command, static_cast<std::uint8_t>(g.expected.data ? 1 : 0),
                                 static_cast<std::uint8_t>(g.expected.data ? g.expected.data_size - 1 : 0)};
-    write(dir / "reply" / ("golden-" + std::to_string(i++)), hdr, g.frame);
+    write(dir / "reply" / ("golden-" + std::to_string(i)), hdr, g.frame);
+    write(dir / "frames" / ("golden-" + std::to_string(i++)), {}, g.frame);
   }
   std::printf("wrote %zu command and %zu reply seeds to %s\n", std::size(rcb4::golden::requests),
               std::size(rcb4::golden::replies), argv[1]);

@@ -5,6 +5,7 @@
 #   python3 tests/integration/standin.py [--mode nack|badsum|echo|drop|short|empty|late|die]
 # SPDX-License-Identifier: BSL-1.0
 import os
+import socket
 import threading
 import time
 import tty
@@ -19,7 +20,7 @@ class StandIn:
     allocation table of zeros (a board nobody set up), "late" answers 300 ms late, "die" stops
     answering after `die_after` frames (a board that loses power mid-transfer)."""
 
-    def __init__(self, silent=False, mode=None, die_after=20):
+    def __init__(self, silent=False, mode=None, die_after=20, tcp=False):
         self.mode = mode
         self.die_after = die_after
         self.ram = bytearray(0x490)
@@ -34,11 +35,21 @@ class StandIn:
             self.ram[0x90 + 20 * k + 4:0x90 + 20 * k + 8] = (7500).to_bytes(2, "little") * 2
         self.frames = []
         self.silent = silent
+        if tcp:  # tcp=True: one client on a loopback port (path is HOST:PORT), as ser2net would
+            self.listener = socket.create_server(("127.0.0.1", 0))
+            self.path = "127.0.0.1:%d" % self.listener.getsockname()[1]
+            threading.Thread(target=self.accept, daemon=True).start()
+            return
         self.master, slave = os.openpty()
         tty.setraw(slave)
         self.path = os.ttyname(slave)
         self.slave = slave
         threading.Thread(target=self.serve, daemon=True).start()
+
+    def accept(self):
+        self.conn, _ = self.listener.accept()
+        self.master = self.conn.fileno()
+        self.serve()
 
     def reply(self, b):
         if self.mode == "nack":
@@ -56,6 +67,8 @@ class StandIn:
             try:
                 got = os.read(self.master, 512)
             except OSError:
+                return
+            if not got:  # a TCP client that closed
                 return
             if self.mode == "echo":
                 os.write(self.master, got)

@@ -104,6 +104,52 @@ TEST_CASE("ops: the read planner is exact", "[ops][planner]") {
   }
 }
 
+TEST_CASE("ops: the heap-free planner makes the same plan, and says when it cannot hold one", "[ops][planner]") {
+  std::mt19937 rng(11);
+  for (int round = 0; round < 300; ++round) {
+    std::vector<ops::byte_range> ranges;  // overlapping, touching, out of order, long: all allowed
+    const int n = std::uniform_int_distribution<int>(0, 35)(rng);
+    for (int i = 0; i < n; ++i)
+      ranges.push_back({static_cast<std::uint32_t>(std::uniform_int_distribution<int>(0, 1000)(rng)),
+                        static_cast<std::uint32_t>(std::uniform_int_distribution<int>(0, 150)(rng))});
+    const auto cost =
+        ops::link_cost::at(1250000, std::chrono::microseconds(std::uniform_int_distribution<int>(0, 1500)(rng)));
+    const auto heap = ops::plan_reads(ranges, cost);
+    const auto fixed = ops::plan_reads_fixed<80>(ranges, cost);
+    REQUIRE(fixed.has_value());  // 35 ranges of at most 150 bytes: at most 70 parts
+    REQUIRE(std::vector<ops::byte_range>(fixed->begin(), fixed->end()) == heap);
+  }
+  // More ranges than it holds, or more parts after splitting: nothing, never a cut plan.
+  const std::vector<ops::byte_range> three{{0, 2}, {10, 2}, {20, 2}};
+  CHECK_FALSE(ops::plan_reads_fixed<2>(three, {}).has_value());
+  CHECK(ops::plan_reads_fixed<3>(three, {}).has_value());
+  const std::vector<ops::byte_range> long_one{{0x0100, 300}};  // 128 + 128 + 44
+  CHECK_FALSE(ops::plan_reads_fixed<2>(long_one, {}).has_value());
+  REQUIRE(ops::plan_reads_fixed<3>(long_one, {}).has_value());
+  CHECK(ops::plan_reads_fixed<3>(long_one, {})->size() == 3);
+  CHECK(ops::plan_reads_fixed<1>(std::vector<ops::byte_range>{}, {})->empty());
+}
+
+TEST_CASE("ops: read_servo_states_fixed reads what read_servo_states reads, without the heap", "[ops][servo]") {
+  board_wire w;
+  REQUIRE(w.send(single_servo{3, 8000, 0}).is_ack());
+  ops::read_servo_states_fixed fixed(ops::link_cost::at(1250000, 1ms));
+  ops::read_servo_states heap(ops::link_cost::at(1250000, 1ms));
+  const auto frames_fixed = run(w, fixed);
+  const auto frames_heap = run(w, heap);
+  REQUIRE(fixed.error() == errc{});
+  CHECK(frames_fixed == frames_heap);  // the same reads, byte for byte
+  REQUIRE(fixed.value().size() == 20);
+  CHECK(std::vector<ops::servo_state>(fixed.value().begin(), fixed.value().end()) == heap.value());
+  CHECK(fixed.value()[3].target == 8000);
+  // A table no board should have: refused as by the heap version.
+  REQUIRE(w.write_ram(0x0044, {0x91, 0x00}).is_ack());  // ICS 0 at an odd address
+  ops::read_servo_states_fixed bad;
+  run(w, bad);
+  CHECK(bad.error() == errc::bad_allocation_table);
+  CHECK(bad.value().empty());
+}
+
 TEST_CASE("ops: servo states through the allocation table", "[ops][servo]") {
   board_wire w;
   REQUIRE(w.send(single_servo{3, 8000, 0}).is_ack());

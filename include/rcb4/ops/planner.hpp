@@ -5,14 +5,18 @@
 // wire: a 10-byte request and an (n + 3)-byte reply. Reading a gap between two ranges costs its
 // bytes; a second exchange costs the overhead and 13 more bytes. The planner finds the exact
 // optimum by dynamic programming over the ranges sorted by address (at most 128 bytes a read).
+// plan_reads_fixed makes the same plan without the heap, for firmware.
 #pragma once
 
 #include <rcb4/frame.hpp>
+#include <rcb4/ops/fixed_vector.hpp>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <optional>
+#include <span>
 #include <vector>
 
 namespace rcb4::ops {
@@ -36,34 +40,56 @@ struct link_cost {
   std::chrono::nanoseconds read(std::uint32_t n) const { return exchange + byte_time * (10 + n + 3); }
 };
 
-/** The reads (each ≤ @p read_limit bytes) that cover @p wanted in the least total time. */
-inline std::vector<byte_range> plan_reads(std::vector<byte_range> wanted, link_cost cost,
-                                          std::uint32_t read_limit = 128) {
+namespace detail {
+/**
+ * Sorts @p wanted by address (in place), merges overlapping or touching ranges (reading them
+ * apart never helps) and splits the result into parts of at most @p limit bytes, written to
+ * @p out. Returns how many parts, or nothing when @p out is too small for them.
+ */
+inline std::optional<std::size_t> plan_parts(std::span<byte_range> wanted, std::uint32_t limit,
+                                             std::span<byte_range> out) noexcept {
   std::sort(wanted.begin(), wanted.end(), [](auto& a, auto& b) { return a.address < b.address; });
-  // Merge overlapping or touching ranges first: reading them apart never helps.
-  std::vector<byte_range> r;
+  std::size_t n = 0;
+  bool overflow = false;
+  const auto emit = [&](byte_range x) {
+    for (std::uint32_t off = 0; off < x.size; off += limit) {
+      if (n == out.size()) {
+        overflow = true;
+        return;
+      }
+      out[n++] = {x.address + off, std::min(limit, x.size - off)};
+    }
+  };
+  std::optional<byte_range> cur;
   for (const auto& w : wanted) {
     if (w.size == 0) continue;
-    if (!r.empty() && w.address <= r.back().address + r.back().size) {
-      const auto end = std::max(r.back().address + r.back().size, w.address + w.size);
-      r.back().size = end - r.back().address;
+    if (cur && w.address <= cur->address + cur->size) {
+      cur->size = std::max(cur->address + cur->size, w.address + w.size) - cur->address;
     } else {
-      r.push_back(w);
+      if (cur) emit(*cur);
+      cur = w;
     }
   }
-  // Split anything longer than one read.
-  std::vector<byte_range> parts;
-  for (const auto& x : r)
-    for (std::uint32_t off = 0; off < x.size; off += read_limit)
-      parts.push_back({x.address + off, std::min(read_limit, x.size - off)});
+  if (cur) emit(*cur);
+  if (overflow) return std::nullopt;
+  return n;
+}
+
+/**
+ * The exact optimum over @p parts (sorted, apart, each ≤ @p limit): dynamic programming over
+ * which consecutive parts share one read. @p best and @p from are scratch of parts.size() + 1;
+ * the reads go to @p out (parts.size() at least). Returns how many reads.
+ */
+inline std::size_t choose_reads(std::span<const byte_range> parts, link_cost cost, std::uint32_t limit,
+                                std::span<std::int64_t> best, std::span<std::size_t> from,
+                                std::span<byte_range> out) noexcept {
   const std::size_t n = parts.size();
-  std::vector<std::int64_t> best(n + 1, std::numeric_limits<std::int64_t>::max());
-  std::vector<std::size_t> from(n + 1, 0);
+  std::fill(best.begin(), best.begin() + static_cast<std::ptrdiff_t>(n + 1), std::numeric_limits<std::int64_t>::max());
   best[0] = 0;
   for (std::size_t j = 1; j <= n; ++j) {
     for (std::size_t i = j; i-- > 0;) {  // parts i..j-1 in one read
       const std::uint32_t span = parts[j - 1].address + parts[j - 1].size - parts[i].address;
-      if (span > read_limit) break;
+      if (span > limit) break;
       const auto c = best[i] + cost.read(span).count();
       if (c < best[j]) {
         best[j] = c;
@@ -71,12 +97,50 @@ inline std::vector<byte_range> plan_reads(std::vector<byte_range> wanted, link_c
       }
     }
   }
-  std::vector<byte_range> plan;
+  std::size_t count = 0;
+  for (std::size_t j = n; j > 0; j = from[j]) ++count;
+  std::size_t k = count;
   for (std::size_t j = n; j > 0; j = from[j]) {
     const std::size_t i = from[j];
-    plan.push_back({parts[i].address, parts[j - 1].address + parts[j - 1].size - parts[i].address});
+    out[--k] = {parts[i].address, parts[j - 1].address + parts[j - 1].size - parts[i].address};
   }
-  std::reverse(plan.begin(), plan.end());
+  return count;
+}
+}  // namespace detail
+
+/** The reads (each ≤ @p read_limit bytes, 1–128) that cover @p wanted in the least total time. */
+inline std::vector<byte_range> plan_reads(std::vector<byte_range> wanted, link_cost cost,
+                                          std::uint32_t read_limit = 128) {
+  std::size_t bound = 0;  // merging never needs more parts than splitting each range alone
+  for (const auto& w : wanted) bound += (w.size + read_limit - 1) / read_limit;
+  std::vector<byte_range> parts(bound);
+  const std::size_t n = detail::plan_parts(wanted, read_limit, parts).value_or(0);
+  std::vector<std::int64_t> best(n + 1);
+  std::vector<std::size_t> from(n + 1);
+  std::vector<byte_range> plan(n);
+  plan.resize(detail::choose_reads({parts.data(), n}, cost, read_limit, best, from, plan));
+  return plan;
+}
+
+/**
+ * plan_reads without the heap (for firmware): the same reads, held inline; nothing when more
+ * than N ranges are wanted or the plan needs more than N parts before merging reads.
+ */
+template <std::size_t N>
+std::optional<fixed_vector<byte_range, N>> plan_reads_fixed(std::span<const byte_range> wanted, link_cost cost,
+                                                            std::uint32_t read_limit = 128) noexcept {
+  if (wanted.size() > N) return std::nullopt;
+  std::array<byte_range, N> sorted{};
+  std::copy(wanted.begin(), wanted.end(), sorted.begin());
+  std::array<byte_range, N> parts{};
+  const auto n = detail::plan_parts({sorted.data(), wanted.size()}, read_limit, parts);
+  if (!n) return std::nullopt;
+  std::array<std::int64_t, N + 1> best{};
+  std::array<std::size_t, N + 1> from{};
+  std::array<byte_range, N> out{};
+  const auto count = detail::choose_reads({parts.data(), *n}, cost, read_limit, best, from, out);
+  fixed_vector<byte_range, N> plan;
+  for (std::size_t i = 0; i < count; ++i) plan.push_back(out[i]);
   return plan;
 }
 

@@ -8,10 +8,12 @@
 // allocated servo (the operation reads the allocation table first).
 #pragma once
 
+#include <rcb4/ops/fixed_vector.hpp>
 #include <rcb4/ops/memory.hpp>
 #include <rcb4/ops/planner.hpp>
 
 #include <algorithm>
+#include <array>
 #include <functional>
 #include <limits>
 #include <span>
@@ -48,24 +50,31 @@ struct servo_slot {
  * §6) at an even address (its fields are 16-bit words, §7), and no two blocks may overlap. Blocks
  * need not sit at HeartToHeart4's 0x0090 + 20·k (§7: read the table, do not assume it), but a
  * table that breaks these rules would make every reader show made-up angles and every trim write
- * land in another servo's block, so it is refused whole.
+ * land in another servo's block, so it is refused whole. No heap: firmware can call it.
  */
-inline result<std::vector<servo_slot>> parse_allocation_table(std::span<const std::uint8_t> table) {
+inline result<fixed_vector<servo_slot, 35>> parse_allocation_table_fixed(std::span<const std::uint8_t> table) noexcept {
   if (table.size() < 70) return errc::bad_allocation_table;
-  std::vector<servo_slot> slots;
+  fixed_vector<servo_slot, 35> slots;
+  std::array<std::uint16_t, 35> at{};
+  std::size_t n = 0;
   for (unsigned k = 0; k < 35; ++k) {
     const auto a = static_cast<std::uint16_t>(table[2 * k] | (table[2 * k + 1] << 8));
     if (a == ram::no_allocation || a == 0) continue;
     if (a < ram::user_area.value() || std::uint32_t{a} + servo_block::size > ram_size || a % 2 != 0)
       return errc::bad_allocation_table;
     slots.push_back({ics_number::make(k).value(), a});
+    at[n++] = a;
   }
-  std::vector<std::uint16_t> at;
-  for (const auto& s : slots) at.push_back(s.address);
-  std::sort(at.begin(), at.end());
-  for (std::size_t i = 1; i < at.size(); ++i)
+  std::sort(at.begin(), at.begin() + static_cast<std::ptrdiff_t>(n));
+  for (std::size_t i = 1; i < n; ++i)
     if (at[i] < at[i - 1] + servo_block::size) return errc::bad_allocation_table;
   return slots;
+}
+/** parse_allocation_table_fixed's slots in a std::vector. */
+inline result<std::vector<servo_slot>> parse_allocation_table(std::span<const std::uint8_t> table) {
+  const auto slots = parse_allocation_table_fixed(table);
+  if (!slots) return slots.error();
+  return std::vector<servo_slot>(slots->begin(), slots->end());
 }
 
 namespace detail {
@@ -79,17 +88,23 @@ inline result<std::vector<servo_slot>> allocated_slots(const reply& r) {
   if (const auto e = check_reply(r, true, 70); e != errc{}) return e;
   return parse_allocation_table(r.bytes());
 }
+/** allocated_slots without the heap. */
+inline result<fixed_vector<servo_slot, 35>> allocated_slots_fixed(const reply& r) noexcept {
+  if (const auto e = check_reply(r, true, 70); e != errc{}) return e;
+  return parse_allocation_table_fixed(r.bytes());
+}
 /**
  * RAM reads of byte ranges, as plan_reads chooses them for a link, into a RAM image: the read
  * half of every servo-block reader (read_servo_states, scan_slots, robot::read_joints).
- * restart() runs the same plan again without allocating.
+ * restart() runs the same plan again without allocating. Plan: a std::vector of byte_range, or
+ * a fixed_vector (no heap).
  */
-class planned_reads {
+template <class Plan>
+class basic_planned_reads {
  public:
-  planned_reads() = default;
-  /** Plans the reads of @p wanted for @p cost. */
-  planned_reads(std::vector<byte_range> wanted, link_cost cost)
-      : plan_(plan_reads(std::move(wanted), cost)), memory_(ram_size, 0) {}
+  basic_planned_reads() = default;
+  /** Runs the reads @p plan (each inside RAM, at most 128 bytes). */
+  explicit basic_planned_reads(Plan plan) : plan_(std::move(plan)) {}
   /** The next read, or nothing when every read is done. */
   std::optional<command> next() const {
     if (done()) return std::nullopt;
@@ -109,19 +124,29 @@ class planned_reads {
   /** The 16-bit little-endian word read at RAM @p a. */
   std::uint16_t word(std::uint32_t a) const { return static_cast<std::uint16_t>(memory_[a] | (memory_[a + 1] << 8)); }
   /** The reads chosen. */
-  const std::vector<byte_range>& plan() const noexcept { return plan_; }
+  const Plan& plan() const noexcept { return plan_; }
   /** Starts the same reads again. */
   void restart() noexcept { step_ = 0; }
 
  private:
-  std::vector<byte_range> plan_;
-  std::vector<std::uint8_t> memory_;
+  Plan plan_{};
+  std::array<std::uint8_t, ram_size> memory_{};
   std::size_t step_ = 0;
 };
 
+/** Planned reads of any number of ranges (robot::read_joints). */
+class planned_reads : public basic_planned_reads<std::vector<byte_range>> {
+ public:
+  planned_reads() = default;
+  /** Plans the reads of @p wanted for @p cost. */
+  planned_reads(std::vector<byte_range> wanted, link_cost cost)
+      : basic_planned_reads(plan_reads(std::move(wanted), cost)) {}
+};
+
 /**
- * Reads the allocation table, then @p size bytes at @p offset of every allocated block, in the
- * reads plan_reads chooses for the link: the shape of read_servo_states and scan_slots.
+ * Reads the allocation table, then @p size bytes (at most 20) at @p offset of every allocated
+ * block, in the reads plan_reads chooses for the link: the shape of read_servo_states and
+ * scan_slots. No heap.
  */
 class table_then_reads {
  public:
@@ -137,12 +162,13 @@ class table_then_reads {
   /** Takes a reply; true when the last read is in (slots() and word() are then ready). */
   bool on_reply(const reply& r) {
     if (!table_read_) {
-      auto slots = allocated_slots(r);
+      const auto slots = allocated_slots_fixed(r);
       if ((error_ = slots.error()) != errc{}) return false;
-      slots_ = std::move(slots).value();
-      std::vector<byte_range> wanted;
-      for (const auto& s : slots_) wanted.push_back({s.address + offset_, size_});
-      reads_ = planned_reads(std::move(wanted), cost_);
+      slots_ = *slots;
+      std::array<byte_range, 35> wanted{};
+      for (std::size_t i = 0; i < slots_.size(); ++i) wanted[i] = {slots_[i].address + offset_, size_};
+      // 35 ranges of at most 20 bytes (inside one block each) never need more than 35 parts.
+      reads_ = basic_planned_reads(*plan_reads_fixed<35>({wanted.data(), slots_.size()}, cost_));
       table_read_ = true;
       return reads_.done();
     }
@@ -151,19 +177,19 @@ class table_then_reads {
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
   /** The allocated slots, ascending by ICS. */
-  const std::vector<servo_slot>& slots() const noexcept { return slots_; }
+  std::span<const servo_slot> slots() const noexcept { return slots_.view(); }
   /** The 16-bit word read at RAM @p a. */
   std::uint16_t word(std::uint32_t a) const { return reads_.word(a); }
   /** The reads chosen after the table. */
-  const std::vector<byte_range>& plan() const noexcept { return reads_.plan(); }
+  std::span<const byte_range> plan() const noexcept { return reads_.plan().view(); }
 
  private:
   std::uint32_t offset_;
   std::uint32_t size_;
   link_cost cost_;
   bool table_read_ = false;
-  std::vector<servo_slot> slots_;
-  planned_reads reads_;
+  fixed_vector<servo_slot, 35> slots_;
+  basic_planned_reads<fixed_vector<byte_range, 35>> reads_;
   errc error_{};
 };
 }  // namespace detail
@@ -202,11 +228,14 @@ struct servo_state {
   friend bool operator==(const servo_state&, const servo_state&) = default;
 };
 
-/** Reads the allocation table, then trim/position/target of every allocated servo slot (0–34). */
-class read_servo_states {
+/**
+ * Reads the allocation table, then trim/position/target of every allocated servo slot (0–34),
+ * without the heap (firmware can run it): value() is a span over the states held inline.
+ */
+class read_servo_states_fixed {
  public:
   /** Plans its reads for @p cost (the link's byte time and per-exchange overhead). */
-  explicit read_servo_states(link_cost cost = {}) : reads_(2, 6, cost) {}  // trim, position, target
+  explicit read_servo_states_fixed(link_cost cost = {}) : reads_(2, 6, cost) {}  // trim, position, target
   /** The next read. */
   std::optional<command> next() const { return reads_.next(); }
   /** Takes a reply. */
@@ -219,12 +248,36 @@ class read_servo_states {
   /** errc{} or what went wrong. */
   errc error() const noexcept { return reads_.error(); }
   /** One state per allocated servo slot, ascending. */
-  const std::vector<servo_state>& value() const noexcept { return states_; }
+  std::span<const servo_state> value() const noexcept { return states_.view(); }
   /** The reads chosen after the table (for inspection and benchmarks). */
-  const std::vector<byte_range>& plan() const noexcept { return reads_.plan(); }
+  std::span<const byte_range> plan() const noexcept { return reads_.plan(); }
 
  private:
   detail::table_then_reads reads_;
+  fixed_vector<servo_state, 35> states_;
+};
+
+/** Reads the allocation table, then trim/position/target of every allocated servo slot (0–34). */
+class read_servo_states {
+ public:
+  /** Plans its reads for @p cost (the link's byte time and per-exchange overhead). */
+  explicit read_servo_states(link_cost cost = {}) : op_(cost) {}
+  /** The next read. */
+  std::optional<command> next() const { return op_.next(); }
+  /** Takes a reply. */
+  void on_reply(const reply& r) {
+    op_.on_reply(r);
+    if (states_.empty()) states_.assign(op_.value().begin(), op_.value().end());
+  }
+  /** errc{} or what went wrong. */
+  errc error() const noexcept { return op_.error(); }
+  /** One state per allocated servo slot, ascending. */
+  const std::vector<servo_state>& value() const noexcept { return states_; }
+  /** The reads chosen after the table (for inspection and benchmarks). */
+  std::span<const byte_range> plan() const noexcept { return op_.plan(); }
+
+ private:
+  read_servo_states_fixed op_;
   std::vector<servo_state> states_;
 };
 

@@ -1,0 +1,75 @@
+// The board support of the example firmware: ARM's MPS2 AN386 (Cortex-M4) as Debian's
+// qemu-system-arm emulates it. Everything the firmware touches outside the rcb4 codec is here:
+// a polled UART, a millisecond clock and the debugger's semihosting calls (text out, exit status).
+// Porting to another microcontroller means rewriting this file only.
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+
+namespace mps2 {
+
+/** Starts the clock and UART0 (CMSDK APB UART at 0x40004000, TX and RX on, no interrupts). */
+void init() noexcept;
+
+/** Milliseconds since init(); polled from SysTick, so call it (or uart_get) at least once a ms. */
+std::uint32_t now_ms() noexcept;
+
+/** Sends @p b, waiting while the transmit register is full. */
+void uart_put(std::uint8_t b) noexcept;
+
+/** The next received byte, or nothing when none arrived before now_ms() reached @p deadline. */
+std::optional<std::uint8_t> uart_get(std::uint32_t deadline) noexcept;
+
+/** Writes @p text on the host's standard output (semihosting SYS_WRITE0). */
+void print(const char* text) noexcept;
+
+/** Ends the program with exit status @p code on the host (semihosting SYS_EXIT_EXTENDED). */
+[[noreturn]] void exit(int code) noexcept;
+
+/** A line of text built without printf (newlib's printf wants a heap): text, decimal, hex. */
+class line {
+ public:
+  /** Appends @p s. */
+  line& operator<<(const char* s) noexcept {
+    while (*s && n_ + 1 < sizeof buf_) buf_[n_++] = *s++;
+    buf_[n_] = 0;
+    return *this;
+  }
+  /** Appends @p v in decimal. */
+  line& operator<<(long v) noexcept {
+    char d[12];
+    int k = 0;
+    const bool neg = v < 0;
+    unsigned long u = neg ? 0UL - static_cast<unsigned long>(v) : static_cast<unsigned long>(v);
+    do d[k++] = static_cast<char>('0' + u % 10);
+    while ((u /= 10) != 0);
+    if (neg) d[k++] = '-';
+    char s[13];
+    for (int i = 0; i < k; ++i) s[i] = d[k - 1 - i];
+    s[k] = 0;
+    return *this << static_cast<const char*>(s);
+  }
+  /** Appends @p v as 0x and @p digits hex digits. */
+  line& hex(unsigned long v, int digits) noexcept {
+    char s[11] = "0x";
+    for (int i = 0; i < digits && i < 8; ++i) s[2 + i] = "0123456789ABCDEF"[(v >> (4 * (digits - 1 - i))) & 0xF];
+    s[2 + (digits < 8 ? digits : 8)] = 0;
+    return *this << static_cast<const char*>(s);
+  }
+  /** Prints the line and a newline. */
+  void print() noexcept {
+    *this << "\n";
+    mps2::print(buf_);
+    n_ = 0;
+    buf_[0] = 0;
+  }
+
+ private:
+  char buf_[160] = {};
+  std::size_t n_ = 0;
+};
+
+}  // namespace mps2

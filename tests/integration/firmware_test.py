@@ -1,0 +1,91 @@
+#!/usr/bin/env python3
+# The example firmware (examples/firmware) in Debian's qemu-system-arm: a Cortex-M4 (MPS2 AN386)
+# whose UART0 is connected to `rcb4 serve --tcp`. The firmware pings, reads the config word,
+# reads every servo through the planner and moves two servos with one CONST; the test checks its
+# semihosting exit status and output, then asks the board itself (through the rcb4 tool) where
+# the two servos went. Then the same firmware against boards that misbehave (tests/integration/
+# standin.py over TCP): silent, NACK, bad checksums; each must end in its documented exit status.
+#   firmware_test.py FIRMWARE.elf RCB4 [arm-none-eabi-size]
+# SPDX-License-Identifier: BSL-1.0
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import check, finish
+from standin import StandIn
+
+ELF, RCB4 = sys.argv[1], sys.argv[2]
+SIZE = sys.argv[3] if len(sys.argv) > 3 and sys.argv[3] else shutil.which("arm-none-eabi-size")
+QEMU = shutil.which("qemu-system-arm")
+DEADLINE = 60  # QEMU may hold the first byte ~1 s; a firmware stuck on the UART never exits
+
+if QEMU is None:
+    print("SKIPPED: qemu-system-arm is not installed (cmake/install-deps.sh installs it)")
+    sys.exit(77)
+
+if SIZE:
+    out = subprocess.run([SIZE, ELF], capture_output=True, text=True).stdout.split("\n")
+    text, data, bss = out[1].split()[:3]
+    print(f"firmware image: {text} bytes of code, {data} of data, {bss} of bss ({os.path.basename(ELF)})")
+    # No heap: nothing in the image allocates (malloc, operator new) or grows one (_sbrk).
+    nm = subprocess.run([SIZE[:-len("size")] + "nm", ELF], capture_output=True, text=True).stdout.split()
+    heap = sorted({s for s in nm if s in ("malloc", "_malloc_r", "_sbrk", "_sbrk_r", "_Znwj", "_Znaj", "free")})
+    check(nm and not heap, f"the image has no heap: no malloc, operator new or _sbrk ({heap})")
+
+
+def firmware(address):
+    """Runs the firmware with its UART on TCP ADDRESS; returns (exit status, output). QEMU is
+    killed at the deadline: a firmware that hangs fails clearly instead of hanging the suite."""
+    cmd = [QEMU, "-M", "mps2-an386", "-display", "none", "-monitor", "none", "-nodefaults", "-nic", "none",
+           "-serial", f"tcp:{address}", "-semihosting-config", "enable=on,target=native", "-kernel", ELF]
+    start = time.monotonic()
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=DEADLINE)
+    except subprocess.TimeoutExpired as e:
+        out = e.stdout.decode() if isinstance(e.stdout, bytes) else (e.stdout or "")
+        return None, out + f"\n(killed after {DEADLINE} s: the firmware did not exit)"
+    print(f"  (QEMU ran {time.monotonic() - start:.1f} s, exit status {p.returncode})")
+    return p.returncode, p.stdout + p.stderr
+
+
+# --- against the virtual board ------------------------------------------------------------------
+srv = subprocess.Popen([RCB4, "serve", "--tcp", "127.0.0.1:0"], stdout=subprocess.PIPE, text=True)
+try:
+    address = srv.stdout.readline().strip()
+    rc, out = firmware(address)
+    print(out.rstrip())
+    check(rc == 0, f"the firmware ends with exit status 0 on rcb4 serve (got {rc})")
+    check("ping: ACK" in out, "it pinged the board")
+    check("config: 0x" in out and "baud 1250000" in out, "it read and decoded the config word")
+    check("servos: 20 allocated, read in" in out, "it read the 20 servos of the KHR-3HV through the planner")
+    check("  ICS 0: position 7500" in out, "ICS 0 is at the centre (7500) before the move")
+    check("move: ICS 0 -> 8500, ICS 1 -> 6500, 10 frames: ACK" in out, "one CONST frame moved two servos")
+    check("arrived: ICS 0 at 8500, ICS 1 at 6500" in out, "the firmware read them back at their targets")
+    # The board, asked by another program after the firmware has gone: the two servos are there.
+    p = subprocess.run([RCB4, "--json", "--device", f"tcp:{address}", "servo", "get", "0", "1", "2"],
+                       capture_output=True, text=True, timeout=30)
+    states = {s["ics"]: s for s in json.loads(p.stdout)} if p.returncode == 0 else {}
+    check(p.returncode == 0 and states.get(0, {}).get("target") == 8500 and states.get(1, {}).get("target") == 6500
+          and states.get(2, {}).get("target") == 7500,
+          f"rcb4 servo get: ICS 0 and 1 hold 8500 and 6500, ICS 2 did not move ({p.returncode}, {p.stderr.strip()!r})")
+finally:
+    srv.terminate()
+    srv.wait(timeout=10)
+
+# --- against boards that misbehave ---------------------------------------------------------------
+for mode, silent, status, words in [
+        (None, True, 1, "the board did not answer in time"),
+        ("nack", False, 3, "ping: NACK"),
+        ("badsum", False, 2, "three malformed replies in a row"),
+        ("short", False, 2, "three malformed replies in a row")]:
+    board = StandIn(silent=silent, mode=mode, tcp=True)
+    rc, out = firmware(board.path)
+    name = mode or "silent"
+    check(rc == status and words in out,
+          f"a {name} board: exit status {status} and '{words}' (got {rc}: {out.strip().splitlines()[-1:]})")
+
+finish()
