@@ -32,6 +32,21 @@ std::string duration_text(std::chrono::duration<double, std::micro> d) {
   return fmt::format("{:.2f} s", us / 1e6);
 }
 
+std::string position_text(std::uint16_t word, std::string_view zero, bool compact) {
+  if (word == rcb4::servo_position::free_value) return "FREE";
+  if (word == rcb4::servo_position::hold_value) return "HOLD";
+  if (word == 0) return compact ? fmt::format("{:5} {:>6}", 0, zero) : fmt::format("0 ({})", zero);
+  const auto d = rcb4::ops::degrees_of(word);
+  if (!d) return fmt::format("0x{:04X}", word);
+  return compact ? fmt::format("{:5} {:+6.1f}", word, *d) : fmt::format("{} ({:+.1f} deg)", word, *d);
+}
+
+json degrees_json(std::uint16_t word) {
+  const auto d = rcb4::ops::degrees_of(word);
+  if (!d) return nullptr;
+  return std::round(*d * 100) / 100;
+}
+
 std::string join(const std::vector<std::string>& words) {
   std::string out;
   for (const auto& w : words) {

@@ -78,6 +78,15 @@ std::string plural(std::size_t n, std::string_view word);
 /** A duration for people: "640 us", "501.1 ms", "12.34 s". */
 std::string duration_text(std::chrono::duration<double, std::micro> d);
 
+/**
+ * A servo block's position word for people (protocol.md §7): "8389 (+30.0 deg)", "FREE", "HOLD",
+ * and for 0, which is no angle, "0 (@p zero)": "no answer" for a measured position, "never
+ * driven" for a target. @p compact: "8389  +30.0" for tables.
+ */
+std::string position_text(std::uint16_t word, std::string_view zero, bool compact = false);
+/** The angle of a position word in hundredths of a degree, or null (see position_text). */
+json degrees_json(std::uint16_t word);
+
 /** Integer from decimal, 0x hex or negative decimal, checked against [lo, hi]. */
 long long parse_int(std::string_view s, std::string_view what, long long lo, long long hi);
 /** Hex bytes: "07 0F 00", "070F00", "0x07,0x0F" (separators: space, comma, colon). */

@@ -69,14 +69,6 @@ int sensors(session& s, const globals& g) {
   return exit_ok;
 }
 
-std::string position_text(std::uint16_t v) {
-  if (v == rcb4::servo_position::free_value) return "FREE";
-  if (v == rcb4::servo_position::hold_value) return "HOLD";
-  const auto p = rcb4::servo_position::make(v);
-  if (!p) return fmt::format("0x{:04X}", v);
-  return fmt::format("{:5} {:+6.1f}", v, rcb4::ops::to_degrees(*p));
-}
-
 int monitor(session& s, long long hz, long long count, const globals& g) {
   const signal_catcher catcher;  // Ctrl-C ends the monitor after the sample under way
   const bool tty = ::isatty(STDOUT_FILENO) && !g.json;
@@ -111,7 +103,7 @@ int monitor(session& s, long long hz, long long count, const globals& g) {
       for (std::size_t k = 1; k < r.analog.values.size(); ++k) fmt::print(" {:4}", r.analog.values[k]);
       fmt::print("\n");
       for (std::size_t i = 0; i < states.size(); ++i)
-        fmt::print("ICS {:>2} {:<14}{}", states[i].ics.value(), position_text(states[i].position),
+        fmt::print("ICS {:>2} {:<14}{}", states[i].ics.value(), position_text(states[i].position, "silent", true),
                    i % 4 == 3 || i + 1 == states.size() ? "\n" : "  ");
       std::fflush(stdout);
     }

@@ -21,6 +21,7 @@ struct serve_options {
   long long latency_us = 0;
   std::string series = "reboot", shift = "measured";
   long long servos = -1;
+  std::vector<int> silent;
   rcb4::transport::serve_options serve;
   rcb4::board::options board;
 };
@@ -46,6 +47,12 @@ int serve(serve_options& o, const globals& g) {
   o.board.shift = o.shift == "manual" ? shift_encoding::kondo_manual : shift_encoding::measured_2015;
   // The robot --robot names (default: a KHR-3HV), unless --servos asks for anonymous slots.
   o.board.servos = o.servos >= 0 ? rcb4::board::first_slots(static_cast<unsigned>(o.servos)) : robot_of(g).mask();
+  for (const int k : o.silent) {
+    const auto n = rcb4::ics_number::make(k).value();
+    if (!o.board.servos.contains(n))
+      throw usage_error(fmt::format("--silent {}: the board has no servo slot ICS {} to silence", k, k));
+    o.board.unanswered.insert(n);
+  }
 
   std::optional<boost::asio::ip::tcp::endpoint> endpoint;
   if (!o.tcp.empty()) {
@@ -125,6 +132,10 @@ void add_serve_command(CLI::App& app, context& ctx) {
   cmd->add_option("--servos", o->servos,
                   "N anonymous servo slots, ICS 0..N-1, instead of the robot's (ICS 35 is the receiver)")
       ->check(int_range(0, 35));
+  cmd->add_option("--silent", o->silent, "allocated slots whose servo never answers (its measured position stays 0)")
+      ->type_name("ICS,...")
+      ->delimiter(',')
+      ->check(int_range(0, 34));
   cmd->footer(
       "Serves an emulated RCB-4HV wired as the robot --robot names (default: a KHR-3HV, 20 servos,\n"
       "three demo motions) until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"

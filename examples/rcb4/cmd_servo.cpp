@@ -15,20 +15,6 @@ using rcb4::ics_number;
 constexpr double servo_degrees = 135.0;
 constexpr int servo_low = 3500, servo_high = 11500;
 
-std::string position_text(std::uint16_t v) {
-  const auto p = rcb4::servo_position::make(v);
-  if (!p) return fmt::format("0x{:04X}", v);
-  if (p->is_free()) return "FREE";
-  if (p->is_hold()) return "HOLD";
-  return fmt::format("{} ({:+.1f} deg)", v, rcb4::ops::to_degrees(*p));
-}
-
-json position_json(std::uint16_t v) {
-  const auto p = rcb4::servo_position::make(v);
-  if (!p || p->is_free() || p->is_hold()) return nullptr;
-  return std::round(rcb4::ops::to_degrees(*p) * 100) / 100;
-}
-
 void print_states(const std::vector<rcb4::ops::servo_state>& states, const globals& g) {
   if (g.json) {
     json list = json::array();
@@ -37,7 +23,8 @@ void print_states(const std::vector<rcb4::ops::servo_state>& states, const globa
       j["ics"] = st.ics.value();
       j["trim"] = st.trim;
       j["position"] = st.position;
-      j["degrees"] = position_json(st.position);
+      j["degrees"] = degrees_json(st.position);  // null: the servo never answered (0)
+      j["answered"] = st.answered();
       j["target"] = st.target;
       j["target_state"] = st.target == rcb4::servo_position::free_value   ? "free"
                           : st.target == rcb4::servo_position::hold_value ? "hold"
@@ -49,8 +36,8 @@ void print_states(const std::vector<rcb4::ops::servo_state>& states, const globa
   }
   fmt::print("{:>4}  {:>6}  {:<20}  {}\n", "ICS", "trim", "position", "target");
   for (const auto& st : states)
-    fmt::print("{:>4}  {:>6}  {:<20}  {}\n", st.ics.value(), st.trim, position_text(st.position),
-               position_text(st.target));
+    fmt::print("{:>4}  {:>6}  {:<20}  {}\n", st.ics.value(), st.trim, position_text(st.position, "no answer"),
+               position_text(st.target, "never driven"));
 }
 
 /** ICS numbers, each once; none or "all" means every allocated servo (nullopt). */

@@ -203,6 +203,26 @@ with serve("--servos", "4") as dev:
     check(rc == 0 and js["head_yaw"]["allocated"] and not js["left_knee"]["allocated"] and js["left_knee"]["degrees"] is None,
           "joint list marks the joints without a slot, with no made-up angle")
 
+# A servo that never answered (serve --silent 3: its measured position stays 0): no command shows
+# an angle for it (it showed -253.1 degrees, JSON -253.13, exit 0), every other servo has one.
+with serve("--silent", "3") as dev:
+    rc, out, err = run("--device", dev, "servo", "list")
+    row = next((l for l in out.splitlines() if l.split()[:1] == ["3"]), "")
+    check(rc == 0 and "0 (no answer)" in row and "deg" not in row.split("(no answer)")[0] and "-253" not in out,
+          f"servo list: ICS 3 has no angle ({row.strip()!r})")
+    rc, out, err = run("--json", "--device", dev, "servo", "get", "3", "4")
+    got = {s["ics"]: s for s in json.loads(out)} if rc == 0 else {}
+    check(rc == 0 and got[3]["degrees"] is None and got[3]["answered"] is False and got[3]["position"] == 0
+          and got[4]["degrees"] == 0.0 and got[4]["answered"] is True,
+          f"servo get --json: degrees null and answered false for ICS 3 only ({got.get(3)})")
+    rc, out, err = run("--device", dev, "monitor", "--count", "1")
+    check(rc == 0 and "ICS  3     0 silent" in out and "-253" not in out, f"monitor: ICS 3 silent, no angle ({rc})")
+    rc, out, err = run("--json", "--device", dev, "joint", "list")
+    js = {j["ics"]: j for j in json.loads(out)} if rc == 0 else {}
+    check(rc == 0 and js[3]["degrees"] is None and js[4]["degrees"] is not None, "joint list: none for its joint")
+    rc, out, err = run("serve", "--pty", "--servos", "2", "--silent", "5")
+    check(rc == 2 and "--silent 5: the board has no servo slot ICS 5" in err, f"serve --silent of a slot it lacks: exit 2 ({err.strip()!r})")
+
 with serve("--servos", "0") as dev:
     rc, out, err = run("--device", dev, "joint", "list")
     check(rc == 1 and "allocates none of KHR-3HV's joints" in err, f"an empty allocation table: exit 1 ({err.strip()!r})")

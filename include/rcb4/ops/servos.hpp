@@ -29,10 +29,25 @@ inline result<servo_position> from_degrees(double degrees) noexcept {
   if (!(v >= 0.0 && v <= servo_position::max_angle_value)) return errc::position_out_of_range;
   return servo_position::make(static_cast<int>(v + 0.5));
 }
-/** Degrees from centre of @p p (FREE and HOLD have no angle: NaN). */
+/**
+ * Degrees from centre of @p p (FREE and HOLD have no angle: NaN). For a word read from a servo
+ * block use degrees_of(), which also knows that 0 is no angle.
+ */
 inline double to_degrees(servo_position p) noexcept {
   if (p.is_free() || p.is_hold()) return std::numeric_limits<double>::quiet_NaN();
   return (p.value() - double{servo_position::centre_value}) / counts_per_degree;
+}
+/**
+ * The angle of a position word read from a servo block (+4 measured or +6 target, protocol.md §7),
+ * or nothing when it holds none: FREE, HOLD, a word that is no position, and 0. The board writes
+ * +4 from the servo's answers and +6 from its moves; 0 is what a block holds before either
+ * (the servo never answered, or was never driven), not an angle of -253 degrees: a KRS servo's
+ * positions are 3500-11500 (§10).
+ */
+inline std::optional<double> degrees_of(std::uint16_t word) noexcept {
+  const auto p = servo_position::make(word);
+  if (word == 0 || !p || p->is_free() || p->is_hold()) return std::nullopt;
+  return to_degrees(*p);
 }
 
 /** An allocated ICS slot and its servo data block's RAM address. */
@@ -223,8 +238,14 @@ class scan_servos {
 struct servo_state {
   ics_number ics{};            ///< the slot
   std::int16_t trim = 0;       ///< +2 reference (trim)
-  std::uint16_t position = 0;  ///< +4 measured position (servo value − trim)
-  std::uint16_t target = 0;    ///< +6 output position (FREE 0x8000, HOLD 0x7FFF)
+  std::uint16_t position = 0;  ///< +4 measured position (servo value − trim); 0: never answered
+  std::uint16_t target = 0;    ///< +6 output position (FREE 0x8000, HOLD 0x7FFF); 0: never driven
+  /** True when the board has heard from the servo (a measured position other than 0). */
+  bool answered() const noexcept { return position != 0; }
+  /** The measured angle; nothing when the servo never answered (see degrees_of()). */
+  std::optional<double> degrees() const noexcept { return degrees_of(position); }
+  /** The target's angle; nothing when FREE, HOLD or never driven. */
+  std::optional<double> target_degrees() const noexcept { return degrees_of(target); }
   friend bool operator==(const servo_state&, const servo_state&) = default;
 };
 
