@@ -293,6 +293,21 @@ failure explain(const std::error_code& ec, std::string_view what) {
               "the project again from HeartToHeart4 rewrites it"};
     if (ec == rcb4::errc::bad_checksum)
       return {exit_board, std::string(what), "replies fail their checksum: a wrong baud or parity, or a noisy line"};
+    if (ec == rcb4::errc::bad_reply_length)
+      return {exit_board, std::string(what),
+              "the reply is not as long as this command's answer: a wrong baud or parity, another device on the "
+              "line, or a reply cut short; `rcb4 --trace ...` shows the bytes"};
+    if (ec == rcb4::errc::echo_mismatch)
+      return {exit_board, std::string(what),
+              "the reply is for another command: a late answer to an earlier exchange (a slow link needs a longer "
+              "--timeout MS) or another program writing to the line; `rcb4 --trace ...` shows the bytes"};
+    if (ec == rcb4::errc::bad_ack_code)
+      return {exit_board, std::string(what),
+              "a 4-byte reply whose status is neither ACK nor NACK: a wrong baud or parity, or not an RCB-4; "
+              "`rcb4 --trace ...` shows the bytes"};
+    if (ec == rcb4::errc::unexpected_ack)
+      return {exit_board, std::string(what),
+              "the board acknowledged a read instead of answering it: another firmware or device on the line"};
     return {exit_board, std::string(what)};
   }
   if (ec == t::transport_errc::echo)
@@ -311,6 +326,12 @@ failure explain(const std::error_code& ec, std::string_view what) {
   if (ec == std::errc::permission_denied)
     return {exit_io, std::string(what),
             "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)"};
+  if (ec == std::errc::inappropriate_io_control_operation) {  // ENOTTY: /dev/null, a file, a pipe
+    std::string message(what);
+    if (const auto at = message.find(ec.message()); at != std::string::npos)
+      message.replace(at, ec.message().size(), "not a serial port");
+    return {exit_io, message, "give the serial port the board is on (`rcb4 list`), or tcp:HOST:PORT for a bridge"};
+  }
   if (ec == std::errc::no_such_file_or_directory)
     return {exit_io, std::string(what), "no such device: `rcb4 list` shows the serial ports"};
   if (t::is_link_lost(ec)) return {exit_io, std::string(what), "the device went away (unplugged?)"};

@@ -8,6 +8,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
+#include <string>
+#include <vector>
 
 #ifndef RCB4_VERSION
 #define RCB4_VERSION "unknown"
@@ -85,6 +88,42 @@ bool json_requested(int argc, char** argv) {
 
 }  // namespace
 
+/**
+ * For a command line with a global option after the command ("rcb4 doctor --device /dev/ttyUSB0"),
+ * the hint with the option and its value moved before it; nothing when there is none.
+ */
+std::optional<std::string> globals_first(int argc, char** argv) {
+  static constexpr std::string_view with_value[] = {"--device", "--baud", "--timeout", "--robot"};
+  static constexpr std::string_view flags[] = {"--trace", "--json"};
+  std::vector<std::string> front, rest;
+  std::string moved;
+  bool in_command = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string_view a = argv[i];
+    const auto name = a.substr(0, a.find('='));
+    const bool takes_value = std::find(std::begin(with_value), std::end(with_value), name) != std::end(with_value);
+    const bool is_flag = std::find(std::begin(flags), std::end(flags), a) != std::end(flags);
+    if (!in_command && (takes_value || is_flag)) {  // already before the command
+      front.emplace_back(a);
+      if (takes_value && name == a && i + 1 < argc) front.emplace_back(argv[++i]);
+      continue;
+    }
+    if (in_command && (takes_value || is_flag)) {
+      if (moved.empty()) moved = std::string(name);
+      front.emplace_back(a);
+      if (takes_value && name == a && i + 1 < argc) front.emplace_back(argv[++i]);
+      continue;
+    }
+    if (!a.empty() && a[0] != '-') in_command = true;
+    rest.emplace_back(a);
+  }
+  if (moved.empty()) return std::nullopt;
+  std::string line = "rcb4";
+  for (const auto& w : front) line += " " + w;
+  for (const auto& w : rest) line += " " + w;
+  return fmt::format("{} is a global option: put it before the command: {}", moved, line);
+}
+
 int main(int argc, char** argv) {
   cli::context ctx;
   CLI::App app{"rcb4 — talk to KONDO RCB-4 boards (KHR-3HV, KXR), or be one.", "rcb4"};
@@ -96,6 +135,15 @@ int main(int argc, char** argv) {
                                 "serial port (/dev/ttyUSB0, /dev/rcb4-0) or tcp:HOST:PORT (ser2net); "
                                 "default $RCB4_DEVICE, else an in-process virtual board");
   device->type_name("D");
+  // "--device --baud 115200" would take "--baud" as the device: a value is not an option.
+  const CLI::Validator not_an_option(
+      [](std::string& v) -> std::string {
+        if (v.size() > 1 && v[0] == '-')
+          return fmt::format("needs a value, and '{}' is an option (for a path that starts with -, write ./{})", v, v);
+        return {};
+      },
+      "");
+  device->check(not_an_option);
   std::uint32_t baud = 0;
   app.add_option("--baud", baud, "115200, 625000 or 1250000 (default: detected by ping)")
       ->type_name("B")
@@ -114,7 +162,8 @@ int main(int argc, char** argv) {
   app.add_flag("--json", ctx.g.json, "machine-readable output: one JSON object (per line for monitor)");
   app.add_option("--robot", ctx.g.robot,
                  "the robot: a profile file (YAML, see profiles/) or a built-in name: khr-3hv (default), kxr-l2")
-      ->type_name("FILE");
+      ->type_name("FILE")
+      ->check(not_an_option);
 
   cli::add_board_commands(app, ctx);
   cli::add_memory_commands(app, ctx);
@@ -159,13 +208,9 @@ int main(int argc, char** argv) {
           message = fmt::format("unknown command '{}'", remaining.front());
           hint = "see rcb4 --help for the commands";
         }
-        // CLI11 names the arguments it did not expect in its message.
-        const std::string_view said = e.what();
-        for (std::string_view global : {"--device", "--baud", "--timeout", "--trace", "--json", "--robot"})
-          if (const auto at = said.find(global); at != std::string_view::npos && !words.empty() &&
-                                                 (at + global.size() == said.size() || said[at + global.size()] == ' '))
-            hint =
-                fmt::format("{} is a global option: put it before the command (rcb4 {} {} ...)", global, global, words);
+        // A global option after the command: the hint is the command line with it moved first.
+        if (!words.empty())
+          if (const auto fixed = globals_first(argc, argv)) hint = *fixed;
       }
       throw cli::failure(cli::exit_usage, message, hint);
     }

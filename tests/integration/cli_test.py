@@ -185,7 +185,25 @@ expect_rc(["--device", "/dev/does-not-exist", "--baud", "115200", "ping"], 3, "n
 
 # ---- detection names the real cause, with its exit code, and --trace shows its frames --------
 expect_rc(["--device", "/dev/does-not-exist", "ping"], 3, "No such file")
-expect_rc(["--device", "/dev/null", "ping"], 3, "Inappropriate ioctl")
+expect_rc(["--device", "/dev/null", "ping"], 3, "/dev/null: not a serial port")
+rc, out, err = run("--device", "/dev/null", "ping")
+check("Inappropriate ioctl" not in err and "rcb4 list" in err, f"/dev/null: the OS's words replaced, a hint ({err.strip()!r})")
+# Global options after the command: exit 2, and the hint is the whole command line put right.
+rc, out, err = run("doctor", "--device", "/dev/ttyUSB0")
+check(rc == 2 and "put it before the command: rcb4 --device /dev/ttyUSB0 doctor" in err,
+      f"doctor --device X: the hint keeps the device ({err.strip()!r})")
+rc, out, err = run("servo", "list", "--json", "--device=/dev/x")
+check(rc == 2 and "rcb4 --json --device=/dev/x servo list" in err, f"two globals after the command, = form ({err.strip()!r})")
+# An option where a value belongs is not taken as the value.
+for args in (["--device", "--baud", "115200", "ping"], ["--device", "--json", "ping"], ["--robot", "--json", "ping"]):
+    rc, out, err = run(*args)
+    check(rc == 2 and f"needs a value, and '{args[1]}' is an option" in err, f"rcb4 {' '.join(args)}: exit 2 ({err.strip()[:120]!r})")
+# Malformed replies: each names what was wrong and what to do (README: Troubleshooting).
+for mode, args, says, hint in [("short", ["servo", "list"], "reply length byte unexpected", "--trace"),
+                               ("badsum", ["version"], "checksum", "parity")]:
+    bad = StandIn(mode=mode)
+    rc, out, err = run("--device", bad.path, "--baud", "115200", "--timeout", "50", *args)
+    check(rc == 1 and says in err and hint in err, f"a {mode} board, {' '.join(args)}: exit 1, '{says}' with a hint ({err.strip()!r})")
 for mode, rc_wanted, says in [("nack", 1, "NACK"), ("badsum", 1, "checksum"), ("echo", 1, "echoes")]:
     bad = StandIn(mode=mode)
     rc, out, err = run("--device", bad.path, "--timeout", "20", "ping")
