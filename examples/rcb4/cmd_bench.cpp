@@ -119,7 +119,10 @@ int bench(session& s, const bench_options& o, const globals& g) {
     j["plan_reads"] = read_sizes;
     j["exchange_overhead_us"] = std::round(overhead_us * 10) / 10;
     j["byte_time_ns"] = cost.byte_time.count();
-    j["paced"] = !beyond_wire;
+    // Paced: the board answered no faster than its bytes cross a line at the known rate; with the
+    // rate unknown (a TCP bridge) there is nothing to compare with: null, not true.
+    j["paced"] = s.rate_known() ? json(!beyond_wire) : json(nullptr);
+    j["byte_time_measured"] = !s.rate_known() || beyond_wire;
     j["iory_cycle_hz"] = std::round(iory_rate * 10) / 10;
     j["iory_cycle_wire_limit_hz"] = opt(iory_limit);
     j["iory_cycle_link_limit_hz"] = std::round(iory_link * 10) / 10;

@@ -75,6 +75,7 @@ int monitor(session& s, long long hz, long long count, const globals& g) {
   const auto period = std::chrono::microseconds(1000000 / hz);
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
+  bool warned = false;
   for (long long n = 0; !signal_catcher::caught() && (count == 0 || n < count); ++n) {
     const auto states = s.run(rcb4::ops::read_servo_states(rcb4::ops::link_cost::at(s.baud(), 1ms)));
     const auto r = read_all(s);
@@ -108,6 +109,20 @@ int monitor(session& s, long long hz, long long count, const globals& g) {
       std::fflush(stdout);
     }
     next += period;
+    // The rate the user asked for, or as fast as the link allows: then say so once (stderr), and
+    // keep the schedule from running ahead of the clock (no burst when the link is quick again).
+    const auto after = std::chrono::steady_clock::now();
+    if (after > next + period) {
+      next = after;
+      if (!warned && n >= 4) {
+        warned = true;
+        const double achieved = static_cast<double>(n + 1) / std::chrono::duration<double>(after - start).count();
+        fmt::print(stderr,
+                   "rcb4 monitor: warning: {} Hz asked, the board and link give {:.0f} samples a second; every "
+                   "sample is shown as it comes\n",
+                   hz, achieved);
+      }
+    }
     std::this_thread::sleep_until(next);  // the sampling rate the user asked for
   }
   return exit_ok;

@@ -380,8 +380,40 @@ rc, out, err = run("--device", "tcp:" + where, "bench", "--count", "5")
 check(rc == 0 and "line rate unknown" in out and "wire limit" not in out, f"bench over TCP without --baud claims no wire limit ({out[:200]!r})")
 rc, out, err = run("--device", "tcp:" + where, "--baud", "1250000", "bench", "--count", "5")
 check(rc == 0 and "wire limit" in out, "bench over TCP with --baud has its wire limit")
+rc, out, err = run("--json", "--device", "tcp:" + where, "bench", "--count", "5")
+b = json.loads(out) if rc == 0 else {}
+check(rc == 0 and b.get("paced", "absent") is None and b.get("byte_time_measured") is True and b.get("baud") is None,
+      f"bench --json over TCP, rate unknown: paced null, the byte time measured ({b.get('paced', 'absent')}, {b.get('byte_time_ns')})")
+# One client at a time: a second one is closed at once (it waited with no reply, to its timeout).
+first = _socket.create_connection(tuple([where.split(":")[0], int(where.split(":")[1])]))
+first.sendall(bytes([0x03, 0xFE, 0x01]))
+check(first.recv(4) == bytes([0x04, 0xFE, 0x06, 0x08]), "the first TCP client is served")
+t0 = time.monotonic()
+rc, out, err = run("--device", "tcp:" + where, "--baud", "1250000", "--timeout", "2000", "ping")
+check(rc == 3 and ("closed" in err or "reset by peer" in err) and time.monotonic() - t0 < 1.5,
+      f"a second TCP client is closed at once, not left unanswered (rc {rc} in {time.monotonic() - t0:.2f} s: {err.strip()!r})")
+first.close()
+time.sleep(0.1)
+expect_ok(["--device", "tcp:" + where, "--baud", "1250000", "ping"], "ACK")
 srv.terminate()
 srv.wait(timeout=10)
+
+# A motion on a board without its servos ends (it stopped at its first pose, to the timeout).
+none = subprocess.Popen([RCB4, "serve", "--pty", "--servos", "0"], stdout=subprocess.PIPE, text=True)
+t0 = time.monotonic()
+rc, out, err = run("--device", none.stdout.readline().strip(), "motion", "play", "2", "--wait", "--timeout", "10")
+check(rc == 0 and "done after" in out and time.monotonic() - t0 < 6, f"serve --servos 0: motion play 2 --wait ends ({rc}, {time.monotonic() - t0:.1f} s, {err.strip()!r})")
+none.terminate()
+none.wait(timeout=10)
+# monitor faster than the link: says so once on stderr, every line still whole JSON.
+paced = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
+rc, out, err = run("--json", "--device", paced.stdout.readline().strip(), "--baud", "1250000", "monitor", "--hz", "1000",
+                   "--count", "20")
+check(rc == 0 and err.count("1000 Hz asked, the board and link give") == 1 and len(out.splitlines()) == 20
+      and all(json.loads(l)["sample"] >= 0 for l in out.splitlines()),
+      f"monitor --hz 1000 on a slower link warns once ({rc}, {err.strip()[:120]!r})")
+paced.terminate()
+paced.wait(timeout=10)
 
 # ---- found by a newcomer trial ---------------------------------------------------------------
 # A late reply to a request the previous program gave up on must not answer the next program's.

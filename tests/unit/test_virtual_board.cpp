@@ -342,3 +342,31 @@ TEST_CASE("board: sensors, PIO, receiver, timers", "[board][io]") {
   w.wait(500ms);
   CHECK(w.read_word(0x003C) == 0);
 }
+
+TEST_CASE("board: a servo command sets no update flag for a slot without a servo", "[board][servo][motion]") {
+  board::options two;
+  two.servos = board::first_slots(2);  // ICS 0 and 1 only
+  board_wire w(two);
+  servo_set<servo_position> targets;
+  for (int k : {0, 3, 9}) targets.insert(ics_number::make(k).value(), servo_position{8000});
+  REQUIRE(w.send(const_servo::make(targets, frames{5}).value()).is_ack());
+  CHECK(w.read_ram(0x0007, 5) == bytes({0x01, 0, 0, 0, 0}));  // ICS 0 only (DOC-CMD p18: the others 0)
+  w.wait(80ms);
+  CHECK(w.read_ram(0x0007, 5) == bytes({0, 0, 0, 0, 0}));
+  CHECK(w.read_word(0x0090 + 4) == 8000);
+
+  // A motion written for a whole robot runs to its end on a board with none of its servos (it
+  // stopped for ever at its first pose, and `motion play 2 --wait` ran to its timeout).
+  board::options none;
+  none.servos = board::first_slots(0);
+  board_wire empty(none);
+  REQUIRE(empty.send(call{motion_address(hth4_2_2, 2).value()}).is_ack());
+  auto cfg = config_word::decode(empty.read_word(0));
+  cfg.rom_program = true;
+  const std::uint16_t c = cfg.encode();
+  REQUIRE(empty.write_ram(0x0000, {static_cast<std::uint8_t>(c & 0xFF), static_cast<std::uint8_t>(c >> 8)}).is_ack());
+  int ticks = 0;
+  while (empty.read_ram(0x0005, 5) != bytes({0, 0, 0, 0, 0}) && ticks++ < 200) empty.wait(10ms);
+  CHECK(ticks < 200);
+  CHECK(empty.read_ram(0x0007, 5) == bytes({0, 0, 0, 0, 0}));
+}

@@ -511,10 +511,18 @@ class virtual_board {
   outcome run(const ics_exchange&, origin) {
     return nack();  // model: the virtual servos do not answer raw ICS (the board NACKs a silent servo)
   }
+  /**
+   * The update flags of a servo command: set for the commanded servos that have a slot, 0 for the
+   * others (DOC-CMD p18; motions.md §5): a flag no interpolation will clear would stop the program
+   * for ever, as a motion listing an unallocated ICS did on a board with fewer servos.
+   */
   void set_update_flags(servo_mask commanded, update_flags mode) {
     if (mode == update_flags::leave) return;
+    servo_mask allocated;
+    for (auto n : commanded)
+      if (block_of(n) && n.value() != 35) allocated.insert(n);
     for (unsigned i = 0; i < 5; ++i)
-      ram_[ram::update_flags.value() + i] = static_cast<std::uint8_t>((commanded.bits() >> (8 * i)) & 0xFFu);
+      ram_[ram::update_flags.value() + i] = static_cast<std::uint8_t>((allocated.bits() >> (8 * i)) & 0xFFu);
   }
   /** Starts interpolating ICS @p n's output to @p pos over @p speed frames; false if unallocated. */
   bool command_servo(ics_number n, servo_position pos, frames speed) {

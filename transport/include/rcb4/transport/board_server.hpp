@@ -60,7 +60,8 @@ class board_server : public std::enable_shared_from_this<board_server> {
     boost::asio::co_spawn(io, s->tick_loop(), boost::asio::detached);
     return s;
   }
-  /** Serves @p board on TCP @p endpoint (port 0 picks one); where() is "HOST:PORT". One client at a time. */
+  /** Serves @p board on TCP @p endpoint (port 0 picks one); where() is "HOST:PORT". One client at a time: another is
+   * closed at once. */
   static std::shared_ptr<board_server> serve_tcp(boost::asio::io_context& io, board::virtual_board& board,
                                                  const boost::asio::ip::tcp::endpoint& endpoint,
                                                  serve_options opt = {}) {
@@ -183,11 +184,20 @@ class board_server : public std::enable_shared_from_this<board_server> {
       boost::system::error_code ec;
       auto socket = co_await acceptor_->async_accept(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
       if (ec) co_return;
+      if (tcp_stream_) {  // one client at a time: another is closed at once, not left unanswered
+        socket.close(ec);
+        continue;
+      }
       socket.set_option(boost::asio::ip::tcp::no_delay(true), ec);
       tcp_stream_.emplace(std::move(socket));
-      co_await serve_stream(*tcp_stream_);
-      tcp_stream_.reset();
+      boost::asio::co_spawn(io_, serve_client(), boost::asio::detached);
     }
+  }
+
+  boost::asio::awaitable<void> serve_client() {
+    auto self = shared_from_this();
+    co_await serve_stream(*tcp_stream_);
+    tcp_stream_.reset();
   }
 
   boost::asio::io_context& io_;
