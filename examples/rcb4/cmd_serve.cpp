@@ -126,6 +126,9 @@ void add_serve_command(CLI::App& app, context& ctx) {
       ->check(CLI::IsMember({"reboot", "execute"}));
   cmd->add_option("--shift", o->shift, "SHIFT counts: measured (default, 2015 report) or manual (KONDO's manual)")
       ->check(CLI::IsMember({"measured", "manual"}));
+  auto* strict = cmd->add_flag("--strict-baud", o->serve.strict_baud,
+                               "on a pty: ignore frames sent at another rate than the board's (as a real line)");
+  strict->needs(pty);
   cmd->add_flag("--arith-to-com", o->board.allow_arith_to_com,
                 "answer arithmetic with COM as destination (refused by default)");
   cmd->add_flag("--strict-timing", o->board.strict_timing, "drop frames whose bytes arrive more than 150 us apart");

@@ -405,6 +405,22 @@ rc, out, err = run("--device", none.stdout.readline().strip(), "motion", "play",
 check(rc == 0 and "done after" in out and time.monotonic() - t0 < 6, f"serve --servos 0: motion play 2 --wait ends ({rc}, {time.monotonic() - t0:.1f} s, {err.strip()!r})")
 none.terminate()
 none.wait(timeout=10)
+# serve --strict-baud: a frame at another rate than the board's gets no reply, as on a real line,
+# so a client's baud handling can be tested (detection finds the board's rate; a wrong --baud fails).
+strict = subprocess.Popen([RCB4, "serve", "--pty", "--strict-baud"], stdout=subprocess.PIPE, text=True)
+sp = strict.stdout.readline().strip()
+rc, out, err = run("--device", sp, "--baud", "115200", "--timeout", "50", "ping")
+check(rc == 4 and "no reply" in err, f"--strict-baud: a client at 115200 to a 1.25 Mbaud board gets no reply, exit 4 ({rc})")
+rc, out, err = run("--json", "--device", sp, "config")
+check(rc == 0 and json.loads(out).get("baud") == 1250000, f"baud detection finds the board's rate ({out.strip()[:100]!r})")
+rc, out, err = run("--device", sp, "config", "set", "baud=115200")
+rc2, out2, err2 = run("--device", sp, "--baud", "1250000", "--timeout", "50", "ping")
+rc3, out3, err3 = run("--device", sp, "--baud", "115200", "ping")
+check(rc == 0 and rc2 == 4 and rc3 == 0, f"after config set baud=115200 only 115200 is answered ({rc}, {rc2}, {rc3})")
+strict.terminate()
+strict.wait(timeout=10)
+expect_rc(["serve", "--tcp", "127.0.0.1:0", "--strict-baud"], 2, "--strict-baud requires --pty")
+
 # monitor faster than the link: says so once on stderr, every line still whole JSON.
 paced = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
 rc, out, err = run("--json", "--device", paced.stdout.readline().strip(), "--baud", "1250000", "monitor", "--hz", "1000",

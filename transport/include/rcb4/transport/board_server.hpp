@@ -13,6 +13,7 @@
 #include <rcb4/board/virtual_board.hpp>
 #include <rcb4/transport/options.hpp>
 #include <rcb4/transport/pty.hpp>
+#include <rcb4/transport/serial.hpp>
 
 #include <boost/asio.hpp>
 
@@ -43,6 +44,11 @@ struct serve_options {
    * (a delayed reply is one piece with a long delay). Bytes past the pieces go out at the end.
    */
   std::function<std::vector<reply_piece>(std::size_t reply_size)> pieces;
+  /**
+   * On a pty: bytes sent at a rate other than the board's COM rate (its config word) are noise
+   * to it and get no reply, as on a real line; without it the pty carries any rate.
+   */
+  bool strict_baud = false;
 };
 
 /** A virtual board served on a pty or TCP. Create with serve_pty() or serve_tcp(); run the io_context. */
@@ -139,6 +145,8 @@ class board_server : public std::enable_shared_from_this<board_server> {
       const auto arrived = clock::now();
       out.clear();
       const std::uint32_t baud = board_.line_baud();  // the rate the request travelled at
+      if (opt_.strict_baud && pty_stream_ && !detail::rate_close(detail::line_rate(pty_stream_->native_handle()), baud))
+        continue;  // another rate: the board hears noise, not a frame
       board_.receive(std::span(buf).first(n), now(), out);
       if (opt_.tamper) opt_.tamper(out);
       if (out.empty()) continue;

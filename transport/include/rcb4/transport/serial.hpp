@@ -47,6 +47,16 @@ inline constexpr tcflag_t kernel_cbaud = 0010017;
 inline constexpr tcflag_t kernel_bother = 0010000;
 inline constexpr tcflag_t kernel_cibaud = kernel_cbaud << 16;  // the input rate's field (IBSHIFT 16)
 
+/**
+ * The output rate set on the terminal @p fd, as termios2 reads it back (for a pty's master: the
+ * rate its user set on the other end); 0 when it cannot be read.
+ */
+inline std::uint32_t line_rate(int fd) noexcept {
+  kernel_termios2 t{};
+  if (::ioctl(fd, tcgets2, &t) != 0) return 0;
+  return t.c_ospeed;
+}
+
 /** True when @p got is within 2 % of @p want (what a UART's divisor can reach). */
 constexpr bool rate_close(std::uint32_t got, std::uint32_t want) noexcept {
   return (got > want ? got - want : want - got) <= want / 50;
