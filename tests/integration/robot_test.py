@@ -16,6 +16,7 @@ RCB4 = sys.argv[1]
 PROFILES = sys.argv[2]
 README_JOINTS = sys.argv[3] if len(sys.argv) > 3 else None  # the README's joints.cpp, built
 from checks import check, finish
+from standin import StandIn
 
 
 def run(*args, stdin=None, timeout=60):
@@ -293,6 +294,12 @@ if README_JOINTS:
                 break
             time.sleep(0.1)
         check(abs(knee["target"] - 40) < 0.1, f"and bends the left knee to 40 degrees ({knee['target']})")
+    # Failures end in a message and exit 1, never in terminate() (exit 134 before).
+    p = subprocess.run([README_JOINTS, "/dev/ttyNOPE9"], capture_output=True, text=True, timeout=60)
+    check(p.returncode == 1 and "No such file or directory" in p.stderr, f"joints.cpp on a missing port: exit 1 ({p.returncode}, {p.stderr.strip()!r})")
+    silent_board = StandIn(silent=True)
+    p = subprocess.run([README_JOINTS, silent_board.path], capture_output=True, text=True, timeout=60)
+    check(p.returncode == 1 and p.stderr.strip() != "", f"joints.cpp on a silent board: exit 1 ({p.returncode}, {p.stderr.strip()!r})")
 
 # Profiles: the shipped files, another robot, bad files.
 rc, out, err = run("--robot", os.path.join(PROFILES, "kxr-l2.yaml"), "joint", "list")
