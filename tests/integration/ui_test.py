@@ -269,6 +269,15 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
             driver.find_elements(By.CSS_SELECTOR, ".joint[data-joint]")) == 20 else None)
         shown = [r.find_element(By.CSS_SELECTOR, ".name").text for r in rows or []]
         check(sorted(shown) == sorted(KHR), f"the page lists every joint by name as rendered ({len(shown)})")
+        # No name is cut, down to a narrow window (at 1280 px long names ended in an ellipsis).
+        for width in (1280, 1024, 800):
+            driver.set_window_size(width, 900)
+            cut = driver.execute_script(
+                "return [...document.querySelectorAll('.joint .name')]"
+                ".filter(e => e.scrollWidth > e.clientWidth + 1 || e.scrollHeight > e.clientHeight + 1)"
+                ".map(e => e.textContent)")
+            check(cut == [], f"at {width} px every joint name is shown whole ({cut})")
+        driver.set_window_size(1400, 1080)
         check(wait_until(lambda: "exchanges/s" in driver.find_element(By.ID, "link-text").text),
               "the link line shows the exchanges")
         check(wait_until(lambda: driver.find_element(By.ID, "role").text == "controlling"), "the page controls")

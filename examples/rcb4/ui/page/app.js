@@ -15,6 +15,8 @@ const el = (tag, attrs = {}, ...kids) => {
   for (const k of kids) e.append(k);
   return e;
 };
+// A joint name with a line-break opportunity after each underscore (text nodes and <wbr>, no HTML).
+const breakable = (name) => name.split(/(?<=_)/).flatMap((part, i) => (i ? [el('wbr'), part] : [part]));
 const fmtDeg = (d) => (d === null || d === undefined ? '–' : (d > 0 ? '+' : '') + d.toFixed(1) + '°');
 
 const ui = {
@@ -156,7 +158,7 @@ function jointRow(j) {
   const angle = el('span', { class: 'angle', text: '–', title: 'measured angle' });
   const target = el('span', { class: 'target', text: '' });
   const row = el('div', { class: 'joint', 'data-joint': j.name },
-    el('span', { class: 'name', text: j.name, title: `ICS ${j.ics}` }),
+    el('span', { class: 'name', title: `ICS ${j.ics}` }, ...breakable(j.name)),
     el('div', { class: 'slider' }, slider, marker),
     angle,
     el('span', { class: 'power' },
