@@ -284,30 +284,27 @@ std::string_view plain_message(std::string_view what) {
 failure explain(const std::error_code& ec, std::string_view what) {
   namespace t = rcb4::transport;
   if (ec.category() == rcb4::codec_category()) {
-    if (ec == rcb4::errc::nack)
-      return {exit_board, std::string(what),
-              "the board refused the command (range, unallocated servo, or a busy program)"};
-    if (ec == rcb4::errc::bad_allocation_table)
-      return {exit_board, std::string(what),
-              "`rcb4 read ram 0x0044 70` shows the table (ICS k's block address at +2k, little-endian); writing "
-              "the project again from HeartToHeart4 rewrites it"};
-    if (ec == rcb4::errc::bad_checksum)
-      return {exit_board, std::string(what), "replies fail their checksum: a wrong baud or parity, or a noisy line"};
-    if (ec == rcb4::errc::bad_reply_length)
-      return {exit_board, std::string(what),
-              "the reply is not as long as this command's answer: a wrong baud or parity, another device on the "
-              "line, or a reply cut short; `rcb4 --trace ...` shows the bytes"};
-    if (ec == rcb4::errc::echo_mismatch)
-      return {exit_board, std::string(what),
-              "the reply is for another command: a late answer to an earlier exchange (a slow link needs a longer "
-              "--timeout MS) or another program writing to the line; `rcb4 --trace ...` shows the bytes"};
-    if (ec == rcb4::errc::bad_ack_code)
-      return {exit_board, std::string(what),
-              "a 4-byte reply whose status is neither ACK nor NACK: a wrong baud or parity, or not an RCB-4; "
-              "`rcb4 --trace ...` shows the bytes"};
-    if (ec == rcb4::errc::unexpected_ack)
-      return {exit_board, std::string(what),
-              "the board acknowledged a read instead of answering it: another firmware or device on the line"};
+    // The codec's and the operations' errors: all exit 1, each with what to do about it.
+    static constexpr std::pair<rcb4::errc, std::string_view> hints[] = {
+        {rcb4::errc::nack, "the board refused the command (range, unallocated servo, or a busy program)"},
+        {rcb4::errc::bad_allocation_table,
+         "`rcb4 read ram 0x0044 70` shows the table (ICS k's block address at +2k, little-endian); writing the "
+         "project again from HeartToHeart4 rewrites it"},
+        {rcb4::errc::bad_checksum, "replies fail their checksum: a wrong baud or parity, or a noisy line"},
+        {rcb4::errc::bad_reply_length,
+         "the reply is not as long as this command's answer: a wrong baud or parity, another device on the line, "
+         "or a reply cut short; `rcb4 --trace ...` shows the bytes"},
+        {rcb4::errc::echo_mismatch,
+         "the reply is for another command: a late answer to an earlier exchange (a slow link needs a longer "
+         "--timeout MS) or another program writing to the line; `rcb4 --trace ...` shows the bytes"},
+        {rcb4::errc::bad_ack_code,
+         "a 4-byte reply whose status is neither ACK nor NACK: a wrong baud or parity, or not an RCB-4; `rcb4 "
+         "--trace ...` shows the bytes"},
+        {rcb4::errc::unexpected_ack,
+         "the board acknowledged a read instead of answering it: another firmware or device on the line"},
+    };
+    for (const auto& [e, hint] : hints)
+      if (ec == e) return {exit_board, std::string(what), std::string(hint)};
     return {exit_board, std::string(what)};
   }
   if (ec == t::transport_errc::echo)
