@@ -5,8 +5,8 @@
 //   rcb4_own_loop --memory         the virtual board in memory: no device, no thread, no clock
 //
 // It reads the config word and every servo's state (ops::read_config, ops::read_servo_states).
-// Exit status: 0 done; 1 the board refused (NACK) or its answers stayed malformed; 3 an I/O error
-// (no such device, not a terminal); 4 the board was silent past the deadline.
+// Exit status: 0 done; 1 the board refused (NACK) or its answers stayed malformed; 2 usage;
+// 3 an I/O error (no such device, not a terminal); 4 the board was silent past the deadline.
 //
 // The contract (see the README, "Your own transport"):
 //   - op.next() gives the command to send, or nothing when the operation is finished;
@@ -25,12 +25,15 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <optional>
+#include <span>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace {
@@ -100,11 +103,12 @@ class fd_link {
     }
     return link_status::ok;
   }
-  /** Reads and drops bytes until the line has been quiet for 20 ms (after a malformed reply). */
+  /** Drops bytes until the line has been quiet for 20 ms, for 200 ms at most (after a malformed reply). */
   void drain() {
     std::uint8_t junk[64];
     pollfd p{fd_, POLLIN, 0};
-    while (::poll(&p, 1, 20) > 0 && ::read(fd_, junk, sizeof junk) > 0) {
+    const auto give_up = clock_type::now() + std::chrono::milliseconds(200);
+    while (clock_type::now() < give_up && ::poll(&p, 1, 20) > 0 && ::read(fd_, junk, sizeof junk) > 0) {
     }
   }
 
@@ -142,30 +146,40 @@ class memory_link {
 };
 
 /**
- * One exchange: @p cmd out, its reply in, by @p timeout. A malformed reply (bad checksum, wrong
- * length or echo) is retried up to twice after draining the line; silence and I/O errors end it.
+ * One exchange: @p cmd out, its reply in, by @p timeout, read into @p rx. The reply returned
+ * points into @p rx (a parsed reply references its bytes, it does not copy them): keep @p rx
+ * alive until the operation has taken the reply. A malformed reply (bad checksum, wrong length
+ * or echo) to a read is retried up to twice after draining the line; a write is not repeated (a
+ * CALL sent twice would push the board's stack twice). Silence and I/O errors end it.
  */
 template <class Link>
 std::optional<rcb4::reply> exchange(Link& link, const rcb4::command& cmd, link_status& status,
+                                    std::span<std::uint8_t, rcb4::max_reply_size> rx,
                                     std::chrono::milliseconds timeout = std::chrono::milliseconds(500)) {
   rcb4::request_frame frame;
-  frame.commit(rcb4::serialize(cmd, frame.storage()).value_or(0));
+  const auto n = rcb4::serialize(cmd, frame.storage());
+  if (!n) {
+    std::fprintf(stderr, "the command does not serialize (%s)\n", rcb4::message(n.error()));
+    status = link_status::malformed;
+    return std::nullopt;
+  }
+  frame.commit(*n);
   const auto shape = rcb4::expected_reply(cmd);
-  for (int attempt = 0; attempt < 3; ++attempt) {
+  const bool repeatable = shape.data || std::holds_alternative<rcb4::ping>(cmd);  // reads and ping only
+  for (int attempt = 0; attempt < (repeatable ? 3 : 1); ++attempt) {
     if ((status = link.send(frame.bytes())) != link_status::ok) return std::nullopt;
-    std::uint8_t rx[rcb4::max_reply_size];
     std::size_t have = 0;
     const auto deadline = clock_type::now() + timeout;
     for (;;) {
-      const auto p = rcb4::parse_reply({rx, have}, shape);
+      const auto p = rcb4::parse_reply(rx.first(have), shape);
       if (p.ok()) return p.value;  // ACK, NACK or data: the operation decides what NACK means
       if (p.status == rcb4::parse_status::error) {
-        std::fprintf(stderr, "malformed reply (%s), retrying\n", rcb4::message(p.error));
+        std::fprintf(stderr, "malformed reply (%s)%s\n", rcb4::message(p.error), repeatable ? ", retrying" : "");
         link.drain();
         status = link_status::malformed;
         break;
       }
-      if ((status = link.receive({rx + have, p.needed}, deadline)) != link_status::ok) return std::nullopt;
+      if ((status = link.receive(rx.subspan(have, p.needed), deadline)) != link_status::ok) return std::nullopt;
       have += p.needed;
     }
   }
@@ -175,9 +189,10 @@ std::optional<rcb4::reply> exchange(Link& link, const rcb4::command& cmd, link_s
 /** Runs @p op to its end; the exit status of the first failure, or 0. */
 template <class Link, class Op>
 int run(Link& link, Op& op, const char* what) {
+  std::array<std::uint8_t, rcb4::max_reply_size> rx{};  // outlives each reply given to op.on_reply()
   while (const auto c = op.next()) {
     link_status status{};
-    const auto r = exchange(link, *c, status);
+    const auto r = exchange(link, *c, status, std::span(rx));
     if (!r) {
       std::fprintf(stderr, "%s: %s\n", what,
                    status == link_status::silent     ? "the board did not answer within 500 ms"

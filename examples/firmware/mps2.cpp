@@ -20,10 +20,10 @@ constexpr std::uint32_t ctrl_tx_enable = 1u << 0, ctrl_rx_enable = 1u << 1;
 
 // SysTick on the processor clock: QEMU's MPS2 runs it at 25 MHz, so 25000 counts are 1 ms.
 constexpr std::uintptr_t syst_csr = 0xE000E010, syst_rvr = 0xE000E014, syst_cvr = 0xE000E018;
-constexpr std::uint32_t csr_enable = 1u << 0, csr_processor_clock = 1u << 2, csr_countflag = 1u << 16;
+constexpr std::uint32_t csr_enable = 1u << 0, csr_tickint = 1u << 1, csr_processor_clock = 1u << 2;
 constexpr std::uint32_t sysclk_hz = 25'000'000;
 
-std::uint32_t g_ms = 0;
+volatile std::uint32_t g_ms = 0;  // counted by systick_handler
 
 // Semihosting (ARM's "Semihosting for AArch32 and AArch64"): BKPT 0xAB, operation in r0, argument in r1.
 constexpr int sys_write0 = 0x04, sys_exit_extended = 0x20;
@@ -45,7 +45,7 @@ namespace mps2 {
 void init() noexcept {
   reg(syst_rvr) = sysclk_hz / 1000 - 1;
   reg(syst_cvr) = 0;
-  reg(syst_csr) = csr_enable | csr_processor_clock;
+  reg(syst_csr) = csr_enable | csr_tickint | csr_processor_clock;
   // QEMU ignores the divider; a real CMSDK UART wants sysclk / baud (>= 16). The RCB-4 speaks 8E1,
   // which this UART cannot: on real hardware pick a UART with even parity (e.g. an STM32 USART
   // with PCE and 9-bit words).
@@ -53,14 +53,13 @@ void init() noexcept {
   reg(uart_ctrl) = ctrl_tx_enable | ctrl_rx_enable;
 }
 
-std::uint32_t now_ms() noexcept {
-  if (reg(syst_csr) & csr_countflag) ++g_ms;  // reading the flag clears it
-  return g_ms;
-}
+std::uint32_t now_ms() noexcept { return g_ms; }
 
-void uart_put(std::uint8_t b) noexcept {
-  while (reg(uart_state) & state_tx_full) now_ms();
+bool uart_put(std::uint8_t b, std::uint32_t deadline) noexcept {
+  while (reg(uart_state) & state_tx_full)
+    if (static_cast<std::int32_t>(now_ms() - deadline) >= 0) return false;
   reg(uart_data) = b;
+  return true;
 }
 
 std::optional<std::uint8_t> uart_get(std::uint32_t deadline) noexcept {
@@ -96,6 +95,9 @@ extern void (*__init_array_start[])(), (*__init_array_end[])();
   mps2::exit(firmware_main());
 }
 
+/** One millisecond more (SysTick, exception 15). */
+void systick_handler() { g_ms = g_ms + 1; }
+
 /** Any fault (a trap from rcb4::result::value() on an error, a bad access) ends the run with 70. */
 [[noreturn]] void fault_handler() {
   mps2::print("firmware: fault\n");
@@ -113,11 +115,11 @@ __attribute__((section(".vectors"), used)) void* const vector_table[16] = {
     nullptr,
     nullptr,
     nullptr,
-    nullptr,                                 // reserved
-    reinterpret_cast<void*>(fault_handler),  // SVCall
-    reinterpret_cast<void*>(fault_handler),  // debug monitor
-    nullptr,                                 // reserved
-    reinterpret_cast<void*>(fault_handler),  // PendSV
-    reinterpret_cast<void*>(fault_handler),  // SysTick (not enabled: it is polled)
+    nullptr,                                   // reserved
+    reinterpret_cast<void*>(fault_handler),    // SVCall
+    reinterpret_cast<void*>(fault_handler),    // debug monitor
+    nullptr,                                   // reserved
+    reinterpret_cast<void*>(fault_handler),    // PendSV
+    reinterpret_cast<void*>(systick_handler),  // SysTick: the millisecond clock
 };
 }

@@ -14,11 +14,11 @@ namespace mps2 {
 /** Starts the clock and UART0 (CMSDK APB UART at 0x40004000, TX and RX on, no interrupts). */
 void init() noexcept;
 
-/** Milliseconds since init(); polled from SysTick, so call it (or uart_get) at least once a ms. */
+/** Milliseconds since init(), counted by the SysTick interrupt. */
 std::uint32_t now_ms() noexcept;
 
-/** Sends @p b, waiting while the transmit register is full. */
-void uart_put(std::uint8_t b) noexcept;
+/** Sends @p b, waiting while the transmit register is full; false when it stayed full past @p deadline. */
+bool uart_put(std::uint8_t b, std::uint32_t deadline) noexcept;
 
 /** The next received byte, or nothing when none arrived before now_ms() reached @p deadline. */
 std::optional<std::uint8_t> uart_get(std::uint32_t deadline) noexcept;
@@ -40,20 +40,21 @@ class line {
   }
   /** Appends @p v in decimal. */
   line& operator<<(long v) noexcept {
-    char d[12];
+    char d[21];  // a 64-bit long too
     int k = 0;
     const bool neg = v < 0;
     unsigned long u = neg ? 0UL - static_cast<unsigned long>(v) : static_cast<unsigned long>(v);
     do d[k++] = static_cast<char>('0' + u % 10);
     while ((u /= 10) != 0);
     if (neg) d[k++] = '-';
-    char s[13];
+    char s[22];
     for (int i = 0; i < k; ++i) s[i] = d[k - 1 - i];
     s[k] = 0;
     return *this << static_cast<const char*>(s);
   }
   /** Appends @p v as 0x and @p digits hex digits. */
   line& hex(unsigned long v, int digits) noexcept {
+    if (digits > 8) digits = 8;
     char s[11] = "0x";
     for (int i = 0; i < digits && i < 8; ++i) s[2 + i] = "0123456789ABCDEF"[(v >> (4 * (digits - 1 - i))) & 0xF];
     s[2 + (digits < 8 ? digits : 8)] = 0;

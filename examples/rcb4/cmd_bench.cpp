@@ -122,7 +122,10 @@ int bench(session& s, const bench_options& o, const globals& g) {
     // Paced: the board answered no faster than its bytes cross a line at the known rate; with the
     // rate unknown (a TCP bridge) there is nothing to compare with: null, not true.
     j["paced"] = s.rate_known() ? json(!beyond_wire) : json(nullptr);
-    j["byte_time_measured"] = !s.rate_known() || beyond_wire;
+    // measure_link keeps the rate's 11 bits a byte unless the link carries bytes faster.
+    j["byte_time_measured"] =
+        cost.byte_time !=
+        rcb4::ops::link_cost::at(s.c().options().baud > 0 ? s.c().options().baud : 115200u, {}).byte_time;
     j["iory_cycle_hz"] = std::round(iory_rate * 10) / 10;
     j["iory_cycle_wire_limit_hz"] = opt(iory_limit);
     j["iory_cycle_link_limit_hz"] = std::round(iory_link * 10) / 10;

@@ -6,6 +6,7 @@
 
 #include <rcb4/transport/error.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
@@ -88,13 +89,19 @@ bool json_requested(int argc, char** argv) {
 
 }  // namespace
 
+namespace {
 /**
  * For a command line with a global option after the command ("rcb4 doctor --device /dev/ttyUSB0"),
- * the hint with the option and its value moved before it; nothing when there is none.
+ * the hint with the option and its value moved before it; nothing when there is none. Only the
+ * options CLI11 left over (@p unexpected) move: a command's own --timeout (seconds, in motion
+ * wait) is not the global one.
  */
-std::optional<std::string> globals_first(int argc, char** argv) {
+std::optional<std::string> globals_first(int argc, char** argv, const std::vector<std::string>& unexpected) {
   static constexpr std::string_view with_value[] = {"--device", "--baud", "--timeout", "--robot"};
   static constexpr std::string_view flags[] = {"--trace", "--json"};
+  const auto left_over = [&](std::string_view a) {
+    return std::find(unexpected.begin(), unexpected.end(), a) != unexpected.end();
+  };
   std::vector<std::string> front, rest;
   std::string moved;
   bool in_command = false;
@@ -103,13 +110,8 @@ std::optional<std::string> globals_first(int argc, char** argv) {
     const auto name = a.substr(0, a.find('='));
     const bool takes_value = std::find(std::begin(with_value), std::end(with_value), name) != std::end(with_value);
     const bool is_flag = std::find(std::begin(flags), std::end(flags), a) != std::end(flags);
-    if (!in_command && (takes_value || is_flag)) {  // already before the command
-      front.emplace_back(a);
-      if (takes_value && name == a && i + 1 < argc) front.emplace_back(argv[++i]);
-      continue;
-    }
-    if (in_command && (takes_value || is_flag)) {
-      if (moved.empty()) moved = std::string(name);
+    if ((takes_value || is_flag) && (!in_command || left_over(a))) {
+      if (in_command && moved.empty()) moved = std::string(name);
       front.emplace_back(a);
       if (takes_value && name == a && i + 1 < argc) front.emplace_back(argv[++i]);
       continue;
@@ -123,6 +125,7 @@ std::optional<std::string> globals_first(int argc, char** argv) {
   for (const auto& w : rest) line += " " + w;
   return fmt::format("{} is a global option: put it before the command: {}", moved, line);
 }
+}  // namespace
 
 int main(int argc, char** argv) {
   cli::context ctx;
@@ -210,7 +213,7 @@ int main(int argc, char** argv) {
         }
         // A global option after the command: the hint is the command line with it moved first.
         if (!words.empty())
-          if (const auto fixed = globals_first(argc, argv)) hint = *fixed;
+          if (const auto fixed = globals_first(argc, argv, app.remaining(true))) hint = *fixed;
       }
       throw cli::failure(cli::exit_usage, message, hint);
     }

@@ -19,7 +19,7 @@ from checks import check, finish
 from standin import StandIn
 
 ELF, RCB4 = sys.argv[1], sys.argv[2]
-SIZE = sys.argv[3] if len(sys.argv) > 3 and sys.argv[3] else shutil.which("arm-none-eabi-size")
+SIZE = sys.argv[3] if len(sys.argv) > 3 and os.path.exists(sys.argv[3]) else shutil.which("arm-none-eabi-size")
 QEMU = shutil.which("qemu-system-arm")
 DEADLINE = 60  # QEMU may hold the first byte ~1 s; a firmware stuck on the UART never exits
 
@@ -33,7 +33,8 @@ if SIZE:
     print(f"firmware image: {text} bytes of code, {data} of data, {bss} of bss ({os.path.basename(ELF)})")
     # No heap: nothing in the image allocates (malloc, operator new) or grows one (_sbrk).
     nm = subprocess.run([SIZE[:-len("size")] + "nm", ELF], capture_output=True, text=True).stdout.split()
-    heap = sorted({s for s in nm if s in ("malloc", "_malloc_r", "_sbrk", "_sbrk_r", "_Znwj", "_Znaj", "free")})
+    heap = sorted({s for s in nm if s in ("malloc", "_malloc_r", "calloc", "realloc", "_sbrk", "_sbrk_r", "_Znwj", "_Znaj",
+                                          "_ZnwjRKSt9nothrow_t", "_ZnajRKSt9nothrow_t", "free")})
     check(nm and not heap, f"the image has no heap: no malloc, operator new or _sbrk ({heap})")
 
 

@@ -235,10 +235,10 @@ class virtual_board {
   std::uint16_t ram16(std::uint32_t addr) const noexcept {
     return static_cast<std::uint16_t>(ram_[addr] | (ram_[addr + 1] << 8));
   }
-  /** The RAM block address of ICS @p n, or nothing when unallocated. */
+  /** The RAM block address of ICS @p n, or nothing when unallocated (0xFFFF, or 0 as on a board without a project). */
   std::optional<std::uint16_t> block_of(ics_number n) const noexcept {
     const std::uint16_t a = allocation(n);
-    if (a == ram::no_allocation || std::uint32_t{a} + servo_block::size > ram_size) return std::nullopt;
+    if (a == ram::no_allocation || a == 0 || std::uint32_t{a} + servo_block::size > ram_size) return std::nullopt;
     return a;
   }
 

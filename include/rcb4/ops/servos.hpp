@@ -182,8 +182,13 @@ class table_then_reads {
       slots_ = *slots;
       std::array<byte_range, 35> wanted{};
       for (std::size_t i = 0; i < slots_.size(); ++i) wanted[i] = {slots_[i].address + offset_, size_};
-      // 35 ranges of at most 20 bytes (inside one block each) never need more than 35 parts.
-      reads_ = basic_planned_reads(*plan_reads_fixed<35>({wanted.data(), slots_.size()}, cost_));
+      // 35 ranges of at most 128 bytes each never need more than 35 parts.
+      const auto plan = plan_reads_fixed<35>({wanted.data(), slots_.size()}, cost_);
+      if (!plan) {
+        error_ = errc::transfer_size_out_of_range;  // a field wider than one read: a caller's mistake
+        return false;
+      }
+      reads_ = basic_planned_reads(*plan);
       table_read_ = true;
       return reads_.done();
     }
@@ -196,7 +201,7 @@ class table_then_reads {
   /** The 16-bit word read at RAM @p a. */
   std::uint16_t word(std::uint32_t a) const { return reads_.word(a); }
   /** The reads chosen after the table. */
-  std::span<const byte_range> plan() const noexcept { return reads_.plan().view(); }
+  const fixed_vector<byte_range, 35>& plan() const noexcept { return reads_.plan(); }
 
  private:
   std::uint32_t offset_;
@@ -268,10 +273,10 @@ class read_servo_states_fixed {
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return reads_.error(); }
-  /** One state per allocated servo slot, ascending. */
-  std::span<const servo_state> value() const noexcept { return states_.view(); }
+  /** One state per allocated servo slot, ascending (a copy of it owns its values). */
+  const fixed_vector<servo_state, 35>& value() const noexcept { return states_; }
   /** The reads chosen after the table (for inspection and benchmarks). */
-  std::span<const byte_range> plan() const noexcept { return reads_.plan(); }
+  const fixed_vector<byte_range, 35>& plan() const noexcept { return reads_.plan(); }
 
  private:
   detail::table_then_reads reads_;
@@ -288,14 +293,14 @@ class read_servo_states {
   /** Takes a reply. */
   void on_reply(const reply& r) {
     op_.on_reply(r);
-    if (states_.empty()) states_.assign(op_.value().begin(), op_.value().end());
+    if (states_.empty()) states_.assign(op_.value().begin(), op_.value().end());  // once, when finished
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return op_.error(); }
   /** One state per allocated servo slot, ascending. */
   const std::vector<servo_state>& value() const noexcept { return states_; }
   /** The reads chosen after the table (for inspection and benchmarks). */
-  std::span<const byte_range> plan() const noexcept { return op_.plan(); }
+  const fixed_vector<byte_range, 35>& plan() const noexcept { return op_.plan(); }
 
  private:
   read_servo_states_fixed op_;

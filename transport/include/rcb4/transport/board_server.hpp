@@ -192,16 +192,41 @@ class board_server : public std::enable_shared_from_this<board_server> {
       boost::system::error_code ec;
       auto socket = co_await acceptor_->async_accept(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
       if (ec) co_return;
-      if (tcp_stream_) {  // one client at a time: another is closed at once, not left unanswered
-        socket.close(ec);
-        continue;
-      }
-      socket.set_option(boost::asio::ip::tcp::no_delay(true), ec);
-      tcp_stream_.emplace(std::move(socket));
-      boost::asio::co_spawn(io_, serve_client(), boost::asio::detached);
+      if (tcp_stream_)
+        boost::asio::co_spawn(io_, take_when_free(std::move(socket)), boost::asio::detached);
+      else
+        start_client(std::move(socket));
     }
   }
 
+  /** Serves @p socket as the one client. */
+  void start_client(boost::asio::ip::tcp::socket socket) {
+    boost::system::error_code ec;
+    socket.set_option(boost::asio::ip::tcp::no_delay(true), ec);
+    tcp_stream_.emplace(std::move(socket));
+    boost::asio::co_spawn(io_, serve_client(), boost::asio::detached);
+  }
+
+  /**
+   * One client at a time: a connection that arrives while another is served waits up to 250 ms
+   * for it to go (a program that reconnects at once after closing), then is closed, never left
+   * unanswered.
+   */
+  boost::asio::awaitable<void> take_when_free(boost::asio::ip::tcp::socket socket) {
+    auto self = shared_from_this();
+    boost::asio::steady_timer wait(io_);
+    boost::system::error_code ec;
+    for (int i = 0; i < 25 && tcp_stream_ && !stopped_; ++i) {
+      wait.expires_after(std::chrono::milliseconds(10));
+      co_await wait.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+    }
+    if (tcp_stream_ || stopped_)
+      socket.close(ec);
+    else
+      start_client(std::move(socket));
+  }
+
+  /** Serves the current client until it goes. */
   boost::asio::awaitable<void> serve_client() {
     auto self = shared_from_this();
     co_await serve_stream(*tcp_stream_);
