@@ -1,6 +1,8 @@
-// rcb4 command-line tool: motion play|stop|resume|status|wait|list (the ROM program's motions, §8).
+// rcb4 command-line tool: motion play|stop|resume|status|wait|list|show (the ROM program's motions, §8).
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
+
+#include <rcb4/motion/disassemble.hpp>
 
 #include <unistd.h>
 
@@ -103,6 +105,86 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
   return exit_ok;
 }
 
+/** `motion show N`: the slot's code as the board runs it, poses in the robot's joints. */
+int show_motion(session& s, int n, const motion_options& o, const globals& g) {
+  namespace m = rcb4::motion;
+  const auto& layout = layout_of(o);
+  const auto where = m::slot_of(layout, static_cast<unsigned>(n));
+  if (!where)
+    throw usage_error(fmt::format("motion {}: the {} layout has motions 1-{}", n, layout.name, layout.motion_count));
+  const auto bytes = s.run(rcb4::ops::read_memory(rcb4::ops::memory::rom, where->address.value(), where->size));
+  const auto& robot = robot_of(g);
+  const bool empty = bytes.empty() || bytes[0] == 0xFF;
+  const auto l = m::disassemble(bytes, *where);
+  const auto lifted = empty ? m::outcome<m::program>{m::failure{"the slot is empty"}} : m::lift(l);
+  json code = json::array();
+  if (!g.json)
+    fmt::print("motion {} at 0x{:06X} ({} layout, slot of {} bytes){}\n", n, where->address.value(), layout.name,
+               where->size, empty ? ": empty (erased ROM)" : "");
+  for (const auto& in : empty ? std::vector<m::instruction>{} : l.code) {
+    const std::string meaning = in.cmd ? fmt::format("{}", *in.cmd) : fmt::format("not a frame: {}", in.error);
+    json joints = json::object();
+    std::string pose_text;
+    if (in.cmd)
+      if (const auto* c = std::get_if<rcb4::const_servo>(&*in.cmd))
+        for (const auto& e : c->targets()) {
+          const auto* j = robot.on(e.ics);
+          const auto d = j ? rcb4::robot::to_degrees(*j, e.value.value()) : std::nullopt;
+          const std::string name = j ? j->name : fmt::format("ICS {}", e.ics.value());
+          joints[name] = d ? json(std::round(*d * 100) / 100) : json(nullptr);
+          pose_text +=
+              fmt::format("  {} {}", name, d ? fmt::format("{:+.1f}", *d) : position_text(e.value.value(), "0"));
+        }
+    if (g.json) {
+      json j{{"address", in.address}, {"hex", fmt::format("{}", rcb4::hex_view{in.bytes})}, {"meaning", meaning}};
+      if (!joints.empty()) j["joints"] = joints;
+      code.push_back(j);
+    } else {
+      fmt::print("  0x{:06X}  {}\n", in.address, meaning);
+      if (!pose_text.empty()) fmt::print("            {}\n", pose_text.substr(2));
+    }
+  }
+  std::vector<std::string> calls;
+  for (const auto a : l.calls) {
+    const auto k = a >= layout.motion_base.value() ? (a - layout.motion_base.value()) / layout.slot_size + 1 : 0;
+    const bool slot_start = k >= 1 && k <= layout.motion_count && m::slot_of(layout, k)->address.value() == a;
+    calls.push_back(slot_start ? fmt::format("motion {} (0x{:06X})", k, a) : fmt::format("0x{:06X}", a));
+  }
+  std::string steps;  // what the code is as steps, checked by assembling them again
+  if (m::ok(lifted)) {
+    std::vector<std::uint8_t> code_bytes;
+    for (const auto& in : l.code) code_bytes.insert(code_bytes.end(), in.bytes.begin(), in.bytes.end());
+    const auto again = m::assemble(std::get<m::program>(lifted), *where);
+    const bool same = m::ok(again) && std::get<std::vector<std::uint8_t>>(again) == code_bytes;
+    steps = fmt::format("{} steps{}", std::get<m::program>(lifted).steps.size(),
+                        same ? ", assembled back to the same bytes" : " that do not assemble back to these bytes");
+  } else {
+    steps = std::get<m::failure>(lifted).message;
+  }
+  if (g.json) {
+    json problems = json::array();
+    if (!empty)
+      for (const auto& p : l.problems) problems.push_back(p);
+    emit(json{{"motion", n},
+              {"address", where->address.value()},
+              {"layout", layout.name},
+              {"empty", empty},
+              {"code", code},
+              {"calls", calls},
+              {"problems", problems},
+              {"steps", m::ok(lifted) ? json(std::get<m::program>(lifted).steps.size()) : json(nullptr)},
+              {"not_steps", m::ok(lifted) ? json(nullptr) : json(steps)}});
+    return exit_ok;
+  }
+  if (empty) return exit_ok;
+  for (const auto& c : calls) fmt::print("calls {}\n", c);
+  for (const auto& p : l.problems) fmt::print("the board stops: {}\n", p);
+  fmt::print("{} reachable frames, {} bytes; {}\n", l.code.size(),
+             l.code.empty() ? 0 : l.code.back().address + l.code.back().bytes.size() - where->address.value(),
+             m::ok(lifted) ? steps : "as steps: " + steps);
+  return exit_ok;
+}
+
 }  // namespace
 
 void add_motion_commands(CLI::App& app, context& ctx) {
@@ -201,6 +283,14 @@ void add_motion_commands(CLI::App& app, context& ctx) {
       fmt::print("{} of {} slots used ({} layout)\n", op.value().size(), layout.motion_count, layout.name);
     return exit_ok;
   });
+
+  auto* show = motion->add_subcommand(
+      "show", "a motion slot disassembled: addresses, frames, and each pose's joints in degrees (from --robot)");
+  auto sho = std::make_shared<motion_options>();
+  auto show_n = std::make_shared<int>(1);
+  show->add_option("N", *show_n, "the motion's number (1-based)")->required()->check(int_range(1, 120));
+  add_layout(show, *sho);
+  on_device(show, ctx, [&ctx, sho, show_n](session& s) { return show_motion(s, *show_n, *sho, ctx.g); });
 
   auto* wait_cmd = motion->add_subcommand("wait", "wait until no motion runs, with a progress line on a terminal");
   auto wo = std::make_shared<motion_options>();

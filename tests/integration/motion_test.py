@@ -1,0 +1,84 @@
+#!/usr/bin/env python3
+# Motions on Linux through the rcb4 tool, as a robot owner uses them: `rcb4 motion show` reads a
+# slot back as the board runs it (the virtual board's demo motions, and a motion written here by
+# hand in HeartToHeart4's patterns of motions.md §1: a loop, a button test, a call of another
+# motion, leftovers of an older motion after its RETURN), with exit codes and JSON checked.
+#   motion_test.py RCB4
+# SPDX-License-Identifier: BSL-1.0
+import contextlib
+import json
+import os
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import check, finish
+
+RCB4 = sys.argv[1]
+
+
+def run(*args, timeout=60):
+    p = subprocess.run([RCB4, *args], capture_output=True, text=True, timeout=timeout)
+    return p.returncode, p.stdout, p.stderr
+
+
+@contextlib.contextmanager
+def serve(*args):
+    srv = subprocess.Popen([RCB4, "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
+    try:
+        yield srv.stdout.readline().strip()
+    finally:
+        srv.terminate()
+        srv.wait(timeout=10)
+
+
+# Written by hand (the checksums summed by hand): motion 10 of the 2.2 layout at 0x005380.
+# CONST ICS 0 = 7500 in 28 frames; C1 = 3; loop: ICS 0 = 8500, ICS 0 = 6500 (10 frames each);
+# SUB 1 from C1, JUMP back if Z = 0; CALL motion 2 (0x001380); while any button is held (SUB S
+# 0x0350 - 0, JUMP if Z = 0) back into the loop; RETURN. Then an older motion's leftovers.
+base = 0x005380
+loop = base + 19
+motion = bytes([0x0B, 0x10, 0x01, 0, 0, 0, 0, 0x1C, 0x4C, 0x1D, 0xA1,
+                0x08, 0x00, 0x02, 0x57, 0x04, 0x00, 0x03, 0x68,
+                0x0B, 0x10, 0x01, 0, 0, 0, 0, 0x0A, 0x34, 0x21, 0x7B,
+                0x0B, 0x10, 0x01, 0, 0, 0, 0, 0x0A, 0x64, 0x19, 0xA3,
+                0x08, 0x07, 0x02, 0x57, 0x04, 0x00, 0x01, 0x6D,
+                0x07, 0x0B, 0x93, 0x53, 0x00, 0x04, 0x07 + 0x0B + 0x93 + 0x53 + 0x04,
+                0x07, 0x0C, 0x80, 0x13, 0x00, 0x00, (0x07 + 0x0C + 0x80 + 0x13) & 0xFF,
+                0x09, 0x07, 0x82, 0x50, 0x03, 0x00, 0x00, 0x00, 0xE5,
+                0x07, 0x0B, 0x93, 0x53, 0x00, 0x04, 0x07 + 0x0B + 0x93 + 0x53 + 0x04,
+                0x03, 0x0D, 0x10,
+                0x0B, 0x10, 0x01, 0, 0, 0, 0, 0x0A, 0x34, 0x21, 0x7B])  # leftovers: not code
+assert motion[51] == loop & 0xFF and motion[52] == loop >> 8  # the JUMP at +49 goes to the loop
+
+with serve() as dev:
+    on = ["--device", dev]
+    rc, out, err = run(*on, "motion", "show", "2")
+    check(rc == 0 and "motion 2 at 0x001380" in out and "right_shoulder_roll +101.2" in out
+          and "6 steps, assembled back to the same bytes" in out, f"motion show 2: the demo wave, poses in joints ({rc}, {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "show", "5")
+    check(rc == 0 and "empty (erased ROM)" in out, f"motion show of an erased slot says so ({out.strip()!r})")
+    rc, out, err = run(*on, "write", "rom", hex(base), motion.hex())
+    assert rc == 0, err
+    rc, out, err = run(*on, "motion", "show", "10")
+    lines = out.splitlines()
+    check(rc == 0 and "  0x00538B  MOV" in out and "calls motion 2 (0x001380)" in out
+          and "10 reachable frames, 82 bytes" in out and "9 steps, assembled back to the same bytes" in out,
+          f"motion show 10: a loop, a call and a button test, the leftovers left out ({rc}: {lines[-2:]})")
+    check(sum(1 for l in lines if l.startswith("  0x")) == 10, "only the reachable frames are listed")
+    rc, out, err = run("--json", *on, "motion", "show", "10")
+    j = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and len(j.get("code", [])) == 10 and j["code"][0]["joints"] == {"head_yaw": 0.0}
+          and j["calls"] == ["motion 2 (0x001380)"] and j["steps"] == 9 and j["problems"] == [] and not j["empty"],
+          f"motion show --json ({str(j)[:160]})")
+    # A slot whose code jumps out of it: the listing says where the board would go.
+    rc, out, err = run(*on, "write", "rom", "0x005B80", "07 0B 00 00 01 00 13")
+    rc, out, err = run(*on, "motion", "show", "11")
+    check(rc == 0 and "the board stops: 0x005B80: jumps out of the slot, to 0x010000" in out, f"a jump out of the slot is named ({out.strip()[-120:]!r})")
+    rc, out, err = run(*on, "motion", "show", "11", "--json")
+    check(rc == 2, "global options go before the command here too")
+    rc, out, err = run(*on, "motion", "show", "--layout", "1.3", "60")
+    check(rc == 2 and "the HTH4 1.3 layout has motions 1-50" in err, f"a motion the layout does not have: exit 2 ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "show", "0")
+    check(rc == 2, "motion 0: exit 2")
+finish()
