@@ -174,12 +174,19 @@ std::optional<rcb4::reply> exchange(Link& link, const rcb4::command& cmd, link_s
       const auto p = rcb4::parse_reply(rx.first(have), shape);
       if (p.ok()) return p.value;  // ACK, NACK or data: the operation decides what NACK means
       if (p.status == rcb4::parse_status::error) {
-        std::fprintf(stderr, "malformed reply (%s)%s\n", rcb4::message(p.error), repeatable ? ", retrying" : "");
+        const bool again = repeatable && attempt + 1 < 3;
+        std::fprintf(stderr, "malformed reply (%s)%s\n", rcb4::message(p.error), again ? ", retrying" : "");
         link.drain();
         status = link_status::malformed;
         break;
       }
-      if ((status = link.receive(rx.subspan(have, p.needed), deadline)) != link_status::ok) return std::nullopt;
+      if ((status = link.receive(rx.subspan(have, p.needed), deadline)) != link_status::ok) {
+        if (status == link_status::silent && have > 0) {  // it began to answer, then stopped
+          std::fprintf(stderr, "the reply stopped short after %zu bytes\n", have);
+          status = link_status::malformed;
+        }
+        return std::nullopt;
+      }
       have += p.needed;
     }
   }
@@ -197,7 +204,7 @@ int run(Link& link, Op& op, const char* what) {
       std::fprintf(stderr, "%s: %s\n", what,
                    status == link_status::silent     ? "the board did not answer within 500 ms"
                    : status == link_status::io_error ? "the line failed (unplugged?)"
-                                                     : "three malformed replies in a row");
+                                                     : "malformed replies (named above), given up");
       return status == link_status::silent ? 4 : status == link_status::io_error ? 3 : 1;
     }
     op.on_reply(*r);

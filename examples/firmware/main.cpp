@@ -100,7 +100,8 @@ void run(Op& op, const char* what) {
   if (op.error() == rcb4::errc::nack) fail(outcome::refused, what);
   if (op.error() != rcb4::errc{}) {  // a malformed reply the operation saw, a nonsense allocation table
     mps2::line l;
-    l << "firmware: " << what << ": " << rcb4::message(op.error());
+    l << "firmware: " << what << ": " << rcb4::message(op.error()) << " (exit " << static_cast<long>(outcome::malformed)
+      << ")";
     l.print();
     mps2::exit(static_cast<int>(outcome::malformed));
   }

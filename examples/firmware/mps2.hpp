@@ -69,7 +69,7 @@ class line {
   }
 
  private:
-  char buf_[160] = {};
+  char buf_[320] = {};  // the longest codec message and a prefix
   std::size_t n_ = 0;
 };
 

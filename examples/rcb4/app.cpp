@@ -331,7 +331,10 @@ failure explain(const std::error_code& ec, std::string_view what) {
   }
   if (ec == std::errc::no_such_file_or_directory)
     return {exit_io, std::string(what), "no such device: `rcb4 list` shows the serial ports"};
-  if (t::is_link_lost(ec)) return {exit_io, std::string(what), "the device went away (unplugged?)"};
+  if (t::is_link_lost(ec))
+    return {exit_io, std::string(what),
+            "the device went away (unplugged?); over TCP at the first exchange: the server has another client "
+            "(rcb4 serve --tcp and ser2net serve one at a time)"};
   return {exit_io, std::string(what)};
 }
 

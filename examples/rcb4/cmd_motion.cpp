@@ -37,12 +37,18 @@ CLI::Option* add_timeout(CLI::App* cmd, motion_options& o, std::string_view what
 json state_json(const rcb4::ops::motion_state& st) {
   json j;
   j["running"] = st.running;
+  j["suspended"] = st.suspended;
   j["motion"] = st.motion ? json(*st.motion) : json(nullptr);
   j["program_counter"] = st.program_counter;
   return j;
 }
 
 std::string state_text(const rcb4::ops::motion_state& st) {
+  if (st.suspended)
+    return fmt::format(
+        "{} stopped part way (program counter 0x{:06X}; the ROM program is off: rcb4 motion resume "
+        "continues it)",
+        st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program"), st.program_counter);
   if (!st.running) return fmt::format("no motion running (program counter 0x{:06X})", st.program_counter);
   if (st.motion) return fmt::format("motion {} running (program counter 0x{:06X})", *st.motion, st.program_counter);
   return fmt::format("a program is running outside the motion slots (program counter 0x{:06X})", st.program_counter);
@@ -73,6 +79,14 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options
                               seconds(), last->program_counter),
                   "wait longer (--timeout S), or stop it: rcb4 motion stop");
   if (ec) throw rcb4::transport::system_error(ec);
+  // Not running because the ROM program is off with a CALL pending: it did not end, it stopped.
+  if (st.suspended)
+    throw failure(exit_board,
+                  fmt::format("{} stopped part way after {:.1f} s: the ROM program is off (program counter 0x{:06X})",
+                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program"), seconds(),
+                              st.program_counter),
+                  "rcb4 motion stop does that, and so does the board on an error (rcb4 config shows program-error); "
+                  "rcb4 motion resume continues it");
   return {seconds(), st};
 }
 
@@ -118,13 +132,16 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   const auto l = m::disassemble(bytes, *where);
   const auto lifted = empty ? m::outcome<m::program>{m::failure{"the slot is empty"}} : m::lift(l);
   json code = json::array();
+  const auto motion_name = robot.motion(static_cast<unsigned>(n));
   if (!g.json)
-    fmt::print("motion {} at 0x{:06X} ({} layout, slot of {} bytes){}\n", n, where->address.value(), layout.name,
-               where->size, empty ? ": empty (erased ROM)" : "");
+    fmt::print("motion {}{} at 0x{:06X} ({} layout, slot of {} bytes){}\n", n,
+               motion_name.empty() ? std::string() : fmt::format(" ({})", motion_name), where->address.value(),
+               layout.name, where->size, empty ? ": empty (erased ROM)" : "");
   for (const auto& in : empty ? std::vector<m::instruction>{} : l.code) {
     const std::string meaning = in.cmd ? fmt::format("{}", *in.cmd) : fmt::format("not a frame: {}", in.error);
     json joints = json::object();
     std::string pose_text;
+    std::vector<std::string> beyond;
     if (in.cmd)
       if (const auto* c = std::get_if<rcb4::const_servo>(&*in.cmd))
         for (const auto& e : c->targets()) {
@@ -134,10 +151,17 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
           joints[name] = d ? json(std::round(*d * 100) / 100) : json(nullptr);
           pose_text +=
               fmt::format("  {} {}", name, d ? fmt::format("{:+.1f}", *d) : position_text(e.value.value(), "0"));
+          // Beyond the profile's limit: shown, not hidden (a motion written for another robot or trim).
+          if (j && d && (*d < j->lower - 1e-6 || *d > j->upper + 1e-6)) {
+            pose_text += fmt::format(" (beyond its {} limit {})", *d < j->lower ? "lower" : "upper",
+                                     *d < j->lower ? j->lower : j->upper);
+            beyond.push_back(j->name);
+          }
         }
     if (g.json) {
       json j{{"address", in.address}, {"hex", fmt::format("{}", rcb4::hex_view{in.bytes})}, {"meaning", meaning}};
       if (!joints.empty()) j["joints"] = joints;
+      if (!beyond.empty()) j["beyond_limits"] = beyond;
       code.push_back(j);
     } else {
       fmt::print("  0x{:06X}  {}\n", in.address, meaning);
@@ -166,12 +190,14 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
     if (!empty)
       for (const auto& p : l.problems) problems.push_back(p);
     emit(json{{"motion", n},
+              {"name", motion_name.empty() ? json(nullptr) : json(std::string(motion_name))},
               {"address", where->address.value()},
               {"layout", layout.name},
               {"empty", empty},
               {"code", code},
               {"calls", calls},
               {"problems", problems},
+              {"notes", empty ? json::array() : json(l.notes)},
               {"steps", m::ok(lifted) ? json(std::get<m::program>(lifted).steps.size()) : json(nullptr)},
               {"not_steps", m::ok(lifted) ? json(nullptr) : json(steps)}});
     return exit_ok;
@@ -179,6 +205,7 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   if (empty) return exit_ok;
   for (const auto& c : calls) fmt::print("calls {}\n", c);
   for (const auto& p : l.problems) fmt::print("the board stops: {}\n", p);
+  for (const auto& note : l.notes) fmt::print("note: {}\n", note);
   fmt::print("{} reachable frames, {} bytes; {}\n", l.code.size(),
              l.code.empty() ? 0 : l.code.back().address + l.code.back().bytes.size() - where->address.value(),
              m::ok(lifted) ? steps : "as steps: " + steps);

@@ -100,11 +100,10 @@ sent_moves move(session& s, const robot::model& m, std::vector<robot::joint_move
   // Only a motion counts: the program counter in a motion slot with the ROM program on (a move's
   // own interpolation also sets the update flags; a stopped motion leaves its PC behind, §8.2).
   if (const auto state = s.run(rcb4::ops::read_motion_state{}); state.running && state.motion)
-    if (s.run(rcb4::ops::read_config{}).rom_program)
-      throw failure(exit_board,
-                    fmt::format("motion {} is running on the board: it would overwrite the move, so nothing was sent",
-                                *state.motion),
-                    "rcb4 motion wait lets it finish; rcb4 motion stop suspends it");
+    throw failure(exit_board,
+                  fmt::format("motion {} is running on the board: it would overwrite the move, so nothing was sent",
+                              *state.motion),
+                  "rcb4 motion wait lets it finish; rcb4 motion stop suspends it");
   robot::move_joints op(std::move(moves));
   rcb4::transport::error_code ec;
   s.run_steps(op, ec, [] {});

@@ -22,6 +22,7 @@ struct serve_options {
   std::string series = "reboot", shift = "measured";
   long long servos = -1;
   std::vector<int> silent;
+  int period_ms = 0;
   rcb4::transport::serve_options serve;
   rcb4::board::options board;
 };
@@ -47,6 +48,7 @@ int serve(serve_options& o, const globals& g) {
   o.board.shift = o.shift == "manual" ? shift_encoding::kondo_manual : shift_encoding::measured_2015;
   // The robot --robot names (default: a KHR-3HV), unless --servos asks for anonymous slots.
   o.board.servos = o.servos >= 0 ? rcb4::board::first_slots(static_cast<unsigned>(o.servos)) : robot_of(g).mask();
+  if (o.period_ms != 0) o.board.period = static_cast<rcb4::output_period>((o.period_ms - 10) / 5);
   for (const int k : o.silent) {
     const auto n = rcb4::ics_number::make(k).value();
     if (!o.board.servos.contains(n))
@@ -126,6 +128,10 @@ void add_serve_command(CLI::App& app, context& ctx) {
       ->check(CLI::IsMember({"reboot", "execute"}));
   cmd->add_option("--shift", o->shift, "SHIFT counts: measured (default, 2015 report) or manual (KONDO's manual)")
       ->check(CLI::IsMember({"measured", "manual"}));
+  cmd->add_option("--period", o->period_ms,
+                  "boot with this servo output period in ms (default: the ROM's, 10; HTH4's sample projects use 15)")
+      ->type_name("MS")
+      ->check(CLI::IsMember({10, 15, 20, 25}));
   auto* strict = cmd->add_flag("--strict-baud", o->serve.strict_baud,
                                "on a pty: ignore frames sent at another rate than the board's (as a real line)");
   strict->needs(pty);

@@ -180,7 +180,8 @@ struct fmt::formatter<rcb4::command> : rcb4::fmt_detail::padded<fmt::formatter<r
             out = write_position(out, x.position());
             return fmt::format_to(out, " in {} frames{}", x.speed().value(), update_suffix(x.flags()));
           } else if constexpr (std::is_same_v<T, const_servo>) {
-            out = fmt::format_to(out, "CONST {} servos in {} frames:", x.targets().size(), x.speed().value());
+            out = fmt::format_to(out, "CONST {} servo{} in {} frames:", x.targets().size(),
+                                 x.targets().size() == 1 ? "" : "s", x.speed().value());
             for (auto e : x.targets()) {
               out = fmt::format_to(out, " {}=", e.ics.value());
               out = write_position(out, e.value);

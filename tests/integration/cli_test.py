@@ -420,6 +420,14 @@ strict.terminate()
 strict.wait(timeout=10)
 expect_rc(["serve", "--tcp", "127.0.0.1:0", "--strict-baud"], 2, "--strict-baud requires --pty")
 
+# serve --period: the board boots with that output period (HTH4's sample projects use 15 ms).
+p15 = subprocess.Popen([RCB4, "serve", "--pty", "--period", "15"], stdout=subprocess.PIPE, text=True)
+rc, out, err = run("--json", "--device", p15.stdout.readline().strip(), "config")
+check(rc == 0 and json.loads(out)["period_ms"] == 15, f"serve --period 15: the config word says 15 ms ({out.strip()[:80]!r})")
+p15.terminate()
+p15.wait(timeout=10)
+expect_rc(["serve", "--pty", "--period", "12"], 2, "--period")
+
 # monitor faster than the link: says so once on stderr, every line still whole JSON.
 paced = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
 rc, out, err = run("--json", "--device", paced.stdout.readline().strip(), "--baud", "1250000", "monitor", "--hz", "1000",

@@ -54,7 +54,7 @@ assert motion[51] == loop & 0xFF and motion[52] == loop >> 8  # the JUMP at +49 
 with serve() as dev:
     on = ["--device", dev]
     rc, out, err = run(*on, "motion", "show", "2")
-    check(rc == 0 and "motion 2 at 0x001380" in out and "right_shoulder_roll +101.2" in out
+    check(rc == 0 and "motion 2 (wave) at 0x001380" in out and "right_shoulder_roll +101.2 (beyond its upper limit 100)" in out
           and "6 steps, assembled back to the same bytes" in out, f"motion show 2: the demo wave, poses in joints ({rc}, {err.strip()!r})")
     rc, out, err = run(*on, "motion", "show", "5")
     check(rc == 0 and "empty (erased ROM)" in out, f"motion show of an erased slot says so ({out.strip()!r})")
@@ -77,6 +77,29 @@ with serve() as dev:
     check(rc == 0 and "the board stops: 0x005B80: jumps out of the slot, to 0x010000" in out, f"a jump out of the slot is named ({out.strip()[-120:]!r})")
     rc, out, err = run(*on, "motion", "show", "11", "--json")
     check(rc == 2, "global options go before the command here too")
+    # A motion stopped part way is not running (motion status said "running" after motion stop).
+    rc, out, err = run(*on, "write", "rom", "0x005B80", "07 0B 80 5B 00 00 ED")  # JUMP to itself: never ends
+    rc, out, err = run(*on, "motion", "show", "11")
+    check("note: 0x005B80: jumps to itself: the motion never ends" in out, f"motion show notes a motion that never ends ({out.strip()[-90:]!r})")
+    rc, out, err = run(*on, "motion", "play", "11")
+    rc2, out2, err2 = run(*on, "motion", "status")
+    check(rc == 0 and rc2 == 0 and out2.startswith("motion 11 running"), f"a motion that loops for ever runs ({out2.strip()!r})")
+    rc, out, err = run(*on, "motion", "stop")
+    rc, out, err = run(*on, "motion", "status")
+    check(rc == 0 and out.startswith("motion 11 stopped part way"), f"after motion stop: stopped part way ({out.strip()!r})")
+    rc, out, err = run("--json", *on, "motion", "status")
+    st = json.loads(out) if rc == 0 else {}
+    check(st.get("running") is False and st.get("suspended") is True and st.get("motion") == 11, f"--json: running false, suspended true ({st})")
+    rc, out, err = run(*on, "motion", "wait", "--timeout", "1")
+    check(rc == 1 and "motion 11 stopped part way" in err and "motion resume" in err, f"motion wait on it: exit 1, says so ({rc}, {err.strip()!r})")
+    rc, out, err = run(*on, "joint", "move", "head_yaw=10")
+    check(rc == 0, "a joint moves while the motion is stopped")
+    rc, out, err = run(*on, "motion", "resume")
+    rc, out, err = run(*on, "motion", "status")
+    check(out.startswith("motion 11 running"), f"resumed: running again ({out.strip()!r})")
+    rc, out, err = run(*on, "joint", "move", "head_yaw=20")
+    check(rc == 1 and "motion 11 is running" in err, f"and a joint move is refused again ({err.strip()!r})")
+    run(*on, "motion", "stop")
     rc, out, err = run(*on, "motion", "show", "--layout", "1.3", "60")
     check(rc == 2 and "the HTH4 1.3 layout has motions 1-50" in err, f"a motion the layout does not have: exit 2 ({err.strip()!r})")
     rc, out, err = run(*on, "motion", "show", "0")

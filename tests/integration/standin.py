@@ -2,7 +2,7 @@
 # An RCB-4 stand-in written here in Python from protocol.md, independent of this project's code:
 # a board that is not ours, for the CLI's tests and the transport bench. As a program it serves
 # one on a pseudo-terminal, prints the path, and serves until killed:
-#   python3 tests/integration/standin.py [--mode nack|badsum|echo|drop|short|empty|late|die]
+#   python3 tests/integration/standin.py [--mode nack|badsum|echo|drop|short|empty|late|die|cut]
 # SPDX-License-Identifier: BSL-1.0
 import os
 import socket
@@ -16,7 +16,8 @@ class StandIn:
     SINGLE/CONST servo (ACK). Records every frame it receives. silent=True answers nothing;
     mode "nack" answers every frame with NACK, "badsum" spoils every reply's checksum, "echo"
     sends every byte back (a loopback plug), "drop" leaves every third frame unanswered,
-    "short" answers data requests with a frame one byte shorter (a wrong length), "empty" has an
+    "short" answers data requests with a frame one byte shorter (a wrong length), "cut" sends every
+    reply without its last byte, "empty" has an
     allocation table of zeros (a board nobody set up), "late" answers 300 ms late, "die" stops
     answering after `die_after` frames (a board that loses power mid-transfer)."""
 
@@ -59,6 +60,9 @@ class StandIn:
         total = (sum(b) + (0x5A if self.mode == "badsum" else 0)) & 0xFF
         if self.mode == "late":
             time.sleep(0.3)
+        if self.mode == "cut":  # the reply stops one byte short (a line that fails mid-reply)
+            os.write(self.master, bytes(b))
+            return
         os.write(self.master, bytes(b) + bytes([total]))
 
     def serve(self):
@@ -111,7 +115,7 @@ class StandIn:
 if __name__ == "__main__":
     import argparse
     ap = argparse.ArgumentParser(description="an RCB-4 stand-in on a pty")
-    ap.add_argument("--mode", choices=["nack", "badsum", "echo", "drop", "short", "empty", "late", "die"])
+    ap.add_argument("--mode", choices=["nack", "badsum", "echo", "drop", "short", "empty", "late", "die", "cut"])
     a = ap.parse_args()
     board = StandIn(mode=a.mode)
     board.frames = None  # (a long run keeps no log)

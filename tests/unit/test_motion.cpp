@@ -85,6 +85,7 @@ TEST_CASE("motion: the assembler refuses what the board could not run, naming th
   CHECK(with({branch_if{button_word, 1, 300, compare::equal, "a"}, label{"a"}, end{}}) ==
         "step 0 (branch_if): a 1-byte value compares with 0-255");
   CHECK(with({set_counter{ram_address{0x048F}, 1}, end{}}) == "(assembled)");
+  CHECK(with({call_motion{rom_address{0x000BB8}}, end{}}).find("step 0 (call_motion): the motion calls itself") == 0);
   // A slot too small: 11 + 3 bytes in 13.
   CHECK(failure_of(assemble(program{{pose{ics0(7500), frames{5}}, end{}}}, slot{rom_address{0x0BB8}, 13})) ==
         "the motion takes 14 bytes, its slot holds 13");
@@ -139,6 +140,11 @@ TEST_CASE("motion: what cannot be read back is named, never made up", "[motion]"
   const auto o = disassemble(out, hth4_2_0_motion_1);
   REQUIRE(o.problems.size() == 1);
   CHECK(o.problems[0] == "0x000BB8: jumps out of the slot, to 0x010000");
+  // Code that runs for ever: listed, with a note.
+  const std::vector<std::uint8_t> forever = {0x07, 0x0B, 0xB8, 0x0B, 0x00, 0x00, 0xD5};  // JUMP 0x000BB8
+  const auto f = disassemble(forever, hth4_2_0_motion_1);
+  CHECK(f.problems.empty());
+  CHECK(f.notes == std::vector<std::string>{"0x000BB8: jumps to itself: the motion never ends (until it is stopped)"});
   // Code that runs off the bytes read.
   const std::vector<std::uint8_t> cut = {0x08, 0x00, 0x02, 0x57, 0x04, 0x00, 0x03, 0x68};  // MOV, then nothing
   CHECK(disassemble(cut, hth4_2_0_motion_1).problems.at(0) == "the code runs on to 0x000BC0, past the 8 bytes read");

@@ -370,3 +370,16 @@ TEST_CASE("board: a servo command sets no update flag for a slot without a servo
   CHECK(ticks < 200);
   CHECK(empty.read_ram(0x0007, 5) == bytes({0, 0, 0, 0, 0}));
 }
+
+TEST_CASE("board: boots with the output period asked (HTH4's samples: 15 ms)", "[board]") {
+  board::options fifteen;
+  fifteen.period = output_period::ms15;
+  board_wire w(fifteen);
+  CHECK(config_word::decode(w.read_word(0)).period == output_period::ms15);
+  CHECK(config_word::decode(board_wire{}.read_word(0)).period == output_period::ms10);  // the ROM's
+  REQUIRE(w.send(single_servo{0, 8500, 10}).is_ack());
+  w.wait(140ms);  // 10 frames of 15 ms: not there yet at 140 ms
+  CHECK(w.read_word(0x0090 + 4) != 8500);
+  w.wait(30ms);
+  CHECK(w.read_word(0x0090 + 4) == 8500);
+}

@@ -160,7 +160,7 @@ class loop {
     mo["slot"] = motion_.motion ? json(*motion_.motion) : json(nullptr);
     mo["rom_program"] = rom_program_;
     // A CALL still pending with the program switched off: stopped part way (motion_stop).
-    mo["suspended"] = motion_.running && !rom_program_;
+    mo["suspended"] = motion_.suspended;
     mo["progress"] = nullptr;
     if (motion_.motion)
       for (const auto& v : motions_)

@@ -54,6 +54,8 @@ struct options {
   std::uint32_t seed = 1;                                ///< AD noise
   servo_mask servos = khr3hv_servos;                     ///< the allocated slots (default: a KHR-3HV's)
   servo_mask unanswered{};                               ///< allocated slots whose servo never answers (+4 stays 0)
+  std::optional<output_period>
+      period{};  ///< boot with this output period, not the ROM config's (15 ms: HTH4's samples)
 };
 
 /** ICS 0..@p n−1 (at most 0..34): a board with @p n anonymous servo slots. */
@@ -163,7 +165,9 @@ class virtual_board {
   /** Resets RAM to the power-on state and boots from ROM (as after a power cycle). */
   void power_on() {
     ram_.fill(0);
-    put16(ram::config.value(), rom16(hth4_2_2.config.value()));
+    auto boot = config_word::decode(rom16(hth4_2_2.config.value()));
+    if (opt_.period) boot.period = *opt_.period;
+    put16(ram::config.value(), boot.encode());
     put24(ram::program_counter.value(), hth4_2_2.main_loop.value());
     put16(ram::pio_direction.value(), 0x03FF);
     for (unsigned k = 0; k < ram::timers; ++k) put16(ram::timer.value() + 2 * k, ram::timer_stopped);

@@ -111,7 +111,12 @@ inline outcome<std::vector<command>> compile(const program& p, slot where, unsig
         return failure{detail::where_step(i, s) + "the label '" + l->name + "' is defined twice"};
       continue;
     }
-    calls = calls || std::holds_alternative<call_motion>(s);
+    if (const auto* c = std::get_if<call_motion>(&s)) {
+      if (c->address == where.address)
+        return failure{detail::where_step(i, s) +
+                       "the motion calls itself: every pass would take a level of the 16-deep stack (go_to loops)"};
+      calls = true;
+    }
     auto cs = detail::commands_of(s, where.address);
     if (!ok(cs)) return failure{detail::where_step(i, s) + std::get<failure>(cs).message};
     for (const auto& c : std::get<std::vector<command>>(cs)) at += static_cast<std::uint32_t>(wire_size(c));

@@ -36,6 +36,7 @@ struct listing {
   std::vector<instruction> code;      ///< every reachable frame, by address
   std::vector<std::uint32_t> calls;   ///< the addresses it CALLs (other motions), ascending
   std::vector<std::string> problems;  ///< what stops the board: a bad frame, a jump out of the slot, ...
+  std::vector<std::string> notes;     ///< what runs but may not be meant: a jump to itself, a call of itself
 };
 
 /** "0x000BB8" */
@@ -51,7 +52,7 @@ inline std::string hex_address(std::uint32_t a) {
  * @p bytes (a MOV's literal): keep them alive while the listing is used.
  */
 inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, const codec_options& opt = {}) {
-  listing out{where, {}, {}, {}};
+  listing out{where, {}, {}, {}, {}};
   const std::uint32_t base = where.address.value();
   const std::size_t have = std::min<std::size_t>(bytes.size(), where.size);
   std::set<std::uint32_t> seen, calls;
@@ -88,9 +89,14 @@ inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, cons
     };
     if (const auto* j = std::get_if<jump>(&r.value)) {
       follow(j->target().value());
-      if (j->cond() != condition::always()) todo.push_back(next);
+      if (j->cond() != condition::always())
+        todo.push_back(next);
+      else if (j->target().value() == at)
+        out.notes.push_back(hex_address(at) + ": jumps to itself: the motion never ends (until it is stopped)");
     } else if (const auto* c = std::get_if<call>(&r.value)) {
       calls.insert(c->target().value());
+      if (c->target().value() == base)
+        out.notes.push_back(hex_address(at) + ": calls its own slot: every pass takes a level of the 16-deep stack");
       todo.push_back(next);
     } else if (!std::holds_alternative<ret>(r.value)) {
       todo.push_back(next);

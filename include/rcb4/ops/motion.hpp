@@ -118,13 +118,19 @@ class play_motion {
 
 /** Whether a motion runs, and which (protocol.md §8.2). */
 struct motion_state {
-  bool running = false;               ///< a CALL is pending (stack or update flags busy)
+  bool running = false;    ///< a CALL is pending (stack or update flags busy) and the ROM program runs
+  bool suspended = false;  ///< a CALL is pending but the ROM program is off: stopped part way (motion stop, an error)
   std::optional<unsigned> motion;     ///< its number under the layout, when the PC is in a motion slot
   std::uint32_t program_counter = 0;  ///< where the ROM program is
   friend bool operator==(const motion_state&, const motion_state&) = default;
 };
 
-/** Reads the program counter block (10 bytes at 0x0002) and decodes the motion state. */
+/**
+ * Reads the config word and the program counter block (12 bytes at 0x0000, one read) and decodes
+ * the motion state: a CALL pending (protocol.md §8.2: SP or update flags non-zero) is running
+ * while the ROM program runs (config bit 1), and suspended when it does not (after motion stop,
+ * or when the board stopped the program on an error).
+ */
 class read_motion_state {
  public:
   /** For motions laid out as @p layout. */
@@ -132,17 +138,21 @@ class read_motion_state {
   /** The read, once. */
   std::optional<command> next() {
     if (done_ || error_ != errc{}) return std::nullopt;
-    return command{move::read_ram(ram::program_counter, 10).value()};
+    return command{move::read_ram(ram::config, 12).value()};
   }
   /** Takes the reply. */
   void on_reply(const reply& r) {
     done_ = true;
-    if ((error_ = detail::check_reply(r, true, 10)) != errc{}) return;
-    const auto b = r.bytes();
+    if ((error_ = detail::check_reply(r, true, 12)) != errc{}) return;
+    const auto c = r.bytes();
+    const bool program_on = config_word::decode(static_cast<std::uint16_t>(c[0] | (c[1] << 8))).rom_program;
+    const auto b = c.subspan(2);  // the block at 0x0002
     state_.program_counter = b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16);
-    state_.running = (b[3] | b[4] | b[5] | b[6] | b[7]) != 0;  // SP, unused, first update flags
+    const bool pending = (b[3] | b[4] | b[5] | b[6] | b[7]) != 0;  // SP, unused, first update flags
+    state_.running = pending && program_on;
+    state_.suspended = pending && !program_on;
     const std::uint32_t base = layout_.motion_base.value();
-    if (state_.running && state_.program_counter >= base) {
+    if (pending && state_.program_counter >= base) {
       const std::uint32_t n = (state_.program_counter - base) / layout_.slot_size + 1;
       if (n <= layout_.motion_count) state_.motion = n;
     }
