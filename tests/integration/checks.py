@@ -16,3 +16,26 @@ def finish():
     """Exits 1 if any check failed, else 0."""
     print(f"\n{len(failures)} check(s) failed" if failures else "\nall checks passed")
     sys.exit(1 if failures else 0)
+
+
+def tool(program):
+    """The two helpers a script that drives the rcb4 tool needs: run(*args) -> (exit code, stdout,
+    stderr), and serve(*args), a context manager that runs `rcb4 serve --pty ARGS` for the duration
+    of a with block and yields its device path."""
+    import contextlib
+    import subprocess
+
+    def run(*args, stdin=None, timeout=60):
+        p = subprocess.run([program, *args], input=stdin, capture_output=True, text=True, timeout=timeout)
+        return p.returncode, p.stdout, p.stderr
+
+    @contextlib.contextmanager
+    def serve(*args):
+        srv = subprocess.Popen([program, "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
+        try:
+            yield srv.stdout.readline().strip()
+        finally:
+            srv.terminate()
+            srv.wait(timeout=10)
+
+    return run, serve

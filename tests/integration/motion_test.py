@@ -5,31 +5,15 @@
 # motion, leftovers of an older motion after its RETURN), with exit codes and JSON checked.
 #   motion_test.py RCB4
 # SPDX-License-Identifier: BSL-1.0
-import contextlib
 import json
 import os
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import check, finish
+from checks import check, finish, tool
 
 RCB4 = sys.argv[1]
-
-
-def run(*args, timeout=60):
-    p = subprocess.run([RCB4, *args], capture_output=True, text=True, timeout=timeout)
-    return p.returncode, p.stdout, p.stderr
-
-
-@contextlib.contextmanager
-def serve(*args):
-    srv = subprocess.Popen([RCB4, "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
-    try:
-        yield srv.stdout.readline().strip()
-    finally:
-        srv.terminate()
-        srv.wait(timeout=10)
+run, serve = tool(RCB4)  # run(*args) -> (exit code, stdout, stderr); with serve(*args) as device: ...
 
 
 # Written by hand (the checksums summed by hand): motion 10 of the 2.2 layout at 0x005380.

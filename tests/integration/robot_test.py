@@ -3,7 +3,6 @@
 # KHR-3HV) in one process, joint/pose/trim/scan/motion commands from others, checked through
 # their exit codes, their JSON and the board's own answers. Expected angles are worked out by hand.
 # SPDX-License-Identifier: BSL-1.0
-import contextlib
 import json
 import os
 import signal
@@ -15,24 +14,10 @@ import time
 RCB4 = sys.argv[1]
 PROFILES = sys.argv[2]
 README_JOINTS = sys.argv[3] if len(sys.argv) > 3 else None  # the README's joints.cpp, built
-from checks import check, finish
+from checks import check, finish, tool
 from standin import StandIn
 
-
-def run(*args, stdin=None, timeout=60):
-    p = subprocess.run([RCB4, *args], input=stdin, capture_output=True, text=True, timeout=timeout)
-    return p.returncode, p.stdout, p.stderr
-
-
-@contextlib.contextmanager
-def serve(*args):
-    """`rcb4 serve --pty ARGS` for the duration of a with block; yields its device path."""
-    srv = subprocess.Popen([RCB4, "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
-    try:
-        yield srv.stdout.readline().strip()
-    finally:
-        srv.terminate()
-        srv.wait(timeout=10)
+run, serve = tool(RCB4)  # run(*args) -> (exit code, stdout, stderr); with serve(*args) as device: ...
 
 
 def joints():
