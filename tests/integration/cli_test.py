@@ -420,6 +420,19 @@ strict.terminate()
 strict.wait(timeout=10)
 expect_rc(["serve", "--tcp", "127.0.0.1:0", "--strict-baud"], 2, "--strict-baud requires --pty")
 
+# SIGINT ends serve at once, also while a reply waits out a long --latency (it waited it out).
+slow_srv = subprocess.Popen([RCB4, "serve", "--pty", "--latency", "5000000"], stdout=subprocess.PIPE, text=True)
+slow_dev = slow_srv.stdout.readline().strip()
+asker = subprocess.Popen([RCB4, "--device", slow_dev, "--baud", "1250000", "--timeout", "100", "ping"],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+time.sleep(0.3)
+t0 = time.monotonic()
+slow_srv.send_signal(signal.SIGINT)
+slow_srv.wait(timeout=10)
+check(slow_srv.returncode == 0 and time.monotonic() - t0 < 1.0,
+      f"serve stops at SIGINT while a reply is delayed ({slow_srv.returncode}, {time.monotonic() - t0:.2f} s)")
+asker.wait(timeout=10)
+
 # serve --period: the board boots with that output period (HTH4's sample projects use 15 ms).
 p15 = subprocess.Popen([RCB4, "serve", "--pty", "--period", "15"], stdout=subprocess.PIPE, text=True)
 rc, out, err = run("--json", "--device", p15.stdout.readline().strip(), "config")

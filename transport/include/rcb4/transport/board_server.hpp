@@ -109,6 +109,7 @@ class board_server : public std::enable_shared_from_this<board_server> {
     if (acceptor_) acceptor_->close(ignored);
     if (pty_stream_) pty_stream_->close(ignored);
     if (tcp_stream_) tcp_stream_->close(ignored);
+    if (pacer_) pacer_->cancel();
     ticker_.cancel();
   }
 
@@ -137,6 +138,12 @@ class board_server : public std::enable_shared_from_this<board_server> {
     std::vector<std::uint8_t> out;
     out.reserve(max_reply_size * 4);
     boost::asio::steady_timer pacer(io_);
+    // stop() cancels a reply's delay (a long --latency would otherwise hold the server that long).
+    pacer_ = &pacer;
+    struct forget {
+      board_server& server;
+      ~forget() { server.pacer_ = nullptr; }
+    } forget_pacer{*this};
     while (!stopped_) {
       boost::system::error_code ec;
       const std::size_t n = co_await stream.async_read_some(
@@ -158,6 +165,7 @@ class board_server : public std::enable_shared_from_this<board_server> {
                          (opt_.pace ? wire_time(n, baud) + wire_time(out.size(), baud) : std::chrono::nanoseconds{0});
         pacer.expires_at(due - wake_lateness_);
         co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+        if (stopped_) co_return;
         while (clock::now() < due) {  // woke early by a few µs: never before the wire allows
         }
         const auto late = clock::now() - (due - wake_lateness_);  // this wake-up's own lateness
@@ -169,6 +177,7 @@ class board_server : public std::enable_shared_from_this<board_server> {
           const std::size_t k = std::min(p.bytes, out.size() - sent);
           pacer.expires_after(p.delay);
           co_await pacer.async_wait(boost::asio::redirect_error(boost::asio::use_awaitable, ec));
+          if (stopped_) co_return;
           co_await boost::asio::async_write(stream, boost::asio::buffer(out.data() + sent, k),
                                             boost::asio::redirect_error(boost::asio::use_awaitable, ec));
           if (ec) co_return;
@@ -245,7 +254,8 @@ class board_server : public std::enable_shared_from_this<board_server> {
   std::optional<boost::asio::ip::tcp::socket> tcp_stream_;
   std::string where_;
   bool stopped_ = false;
-  clock::duration wake_lateness_{0};  // how late the pacer's timer fires, on average
+  clock::duration wake_lateness_{0};            // how late the pacer's timer fires, on average
+  boost::asio::steady_timer* pacer_ = nullptr;  // the serving stream's reply delay, while one is served
   static constexpr clock::duration max_lateness = std::chrono::milliseconds(1);
 };
 
