@@ -15,3 +15,4 @@
 #include <rcb4/result.hpp>
 #include <rcb4/servo_set.hpp>
 #include <rcb4/values.hpp>
+#include <rcb4/vector_entry.hpp>

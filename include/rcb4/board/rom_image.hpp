@@ -3,13 +3,17 @@
 //
 // Layout (protocol.md §8, HTH4 2.2+):
 //   0x000000  boot: MOV ROM 0x0005DC → RAM 0x0000 (config word), then JUMP 0x00044B
-//   0x00044B  main loop: JUMP 0x00044B (the program idles here; motions are CALLed)
+//   0x00044B  main loop: OR 0x08 into the config word (the vector switch on again, as HTH4's
+//             main loop sets it: motions.md §4), JUMP 0x00044B; motions are CALLed
 //   0x0005DC  ConfigDataRom: the config word loaded at power-on
+//   0x000919  the vector table's RAM address (0x0357), 0x00091B: its entries (KRR UP plays
+//             motion 2, DOWN motion 3: HTH4's button pattern, vector_entry::button)
 //   0x000B80 + 2048·(n−1)  motion n: CONST poses, then RETURN
 #pragma once
 
 #include <rcb4/memory_map.hpp>
 #include <rcb4/rcb4.hpp>
+#include <rcb4/vector_entry.hpp>
 
 #include <cstdint>
 #include <initializer_list>
@@ -53,6 +57,9 @@ inline void put_motion(std::vector<std::uint8_t>& rom, const rom_layout& layout,
   put_frame(rom, at, encode(ret{}));
 }
 
+/** The demo's button assignments: KRR button word → motion number. */
+inline constexpr std::pair<std::uint16_t, unsigned> demo_buttons[] = {{0x0001, 2}, {0x0002, 3}};
+
 /** Names of the demo motions, 1-based (index 0 is motion 1). */
 inline constexpr std::string_view demo_motion_names[] = {"home", "wave", "bow"};
 
@@ -66,7 +73,17 @@ inline std::vector<std::uint8_t> default_rom() {
   std::uint32_t at = 0;
   at = put_frame(rom, at, encode(move::make(destination::ram(ram::config), source::rom(l.config, 2).value()).value()));
   put_frame(rom, at, encode(jump{l.main_loop}));
-  put_frame(rom, l.main_loop.value(), encode(jump{l.main_loop}));
+  static constexpr std::uint8_t vector_bit[] = {0x08};  // config bit 3 (a literal is referenced, not copied)
+  const auto vector_on = logic::make(logic_op::or_, destination::ram(ram::config), source::literal(vector_bit).value());
+  put_frame(rom, put_frame(rom, l.main_loop.value(), encode(vector_on.value())), encode(jump{l.main_loop}));
+  rom[0x0919] = static_cast<std::uint8_t>(hth4_ram::vector_entries.value() & 0xFF);
+  rom[0x091A] = static_cast<std::uint8_t>(hth4_ram::vector_entries.value() >> 8);
+  std::uint32_t entry = 0x091B;
+  for (std::size_t j = 0; j < std::size(demo_buttons); ++j) {
+    const auto [buttons, motion] = demo_buttons[j];
+    const auto e = vector_entry::button(buttons, motion_address(l, motion).value(), j + 1 == std::size(demo_buttons));
+    for (auto b : e.encode()) rom[entry++] = b;
+  }
   rom[l.config.value()] = static_cast<std::uint8_t>(default_config & 0xFF);
   rom[l.config.value() + 1] = static_cast<std::uint8_t>(default_config >> 8);
 
