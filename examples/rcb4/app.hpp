@@ -205,17 +205,28 @@ void on_device(CLI::App* cmd, context& ctx, std::function<int(session&)> f);
 void on_run(CLI::App* cmd, context& ctx, std::function<int()> f);
 
 // The command groups, one file each.
-void add_board_commands(CLI::App& app, context& ctx);   ///< ping, version, config (cmd_board.cpp)
-void add_memory_commands(CLI::App& app, context& ctx);  ///< read, write (cmd_memory.cpp)
-void add_servo_commands(CLI::App& app, context& ctx);   ///< servo … (cmd_servo.cpp)
-void add_sensor_commands(CLI::App& app, context& ctx);  ///< sensors, monitor (cmd_sensors.cpp)
-void add_motion_commands(CLI::App& app, context& ctx);  ///< motion … (cmd_motion.cpp)
-void add_bench_command(CLI::App& app, context& ctx);    ///< bench (cmd_bench.cpp)
-void add_host_commands(CLI::App& app, context& ctx);    ///< list, doctor (cmd_host.cpp)
-void add_frame_commands(CLI::App& app, context& ctx);   ///< decode, encode (cmd_frames.cpp)
-void add_serve_command(CLI::App& app, context& ctx);    ///< serve (cmd_serve.cpp)
-void add_robot_commands(CLI::App& app, context& ctx);   ///< joint, pose, trim, scan (cmd_robot.cpp)
-void add_ui_command(CLI::App& app, context& ctx);       ///< ui (cmd_ui.cpp, ui/)
+void add_board_commands(CLI::App& app, context& ctx);      ///< ping, version, config (cmd_board.cpp)
+void add_memory_commands(CLI::App& app, context& ctx);     ///< read, write (cmd_memory.cpp)
+void add_servo_commands(CLI::App& app, context& ctx);      ///< servo … (cmd_servo.cpp)
+void add_sensor_commands(CLI::App& app, context& ctx);     ///< sensors, monitor (cmd_sensors.cpp)
+void add_motion_commands(CLI::App& app, context& ctx);     ///< motion … (cmd_motion.cpp)
+void add_button_commands(CLI::App* motion, context& ctx);  ///< motion buttons … (cmd_buttons.cpp)
+
+/** Options the motion commands share (cmd_motion.cpp). */
+struct motion_options {
+  std::string layout = "auto";  ///< the HTH4 version that wrote the board's program, or auto
+  double timeout_s = 60;        ///< how long --wait / wait waits
+};
+/** Adds --layout (auto, 2.2, 2.0, 2.1, 1.3) to @p cmd. */
+void add_layout(CLI::App* cmd, motion_options& o);
+/** The layout --layout names; auto: told from the ROM (ops::detect_layout), else a failure naming why. */
+const rcb4::rom_layout& layout_for(session& s, const motion_options& o);
+void add_bench_command(CLI::App& app, context& ctx);   ///< bench (cmd_bench.cpp)
+void add_host_commands(CLI::App& app, context& ctx);   ///< list, doctor (cmd_host.cpp)
+void add_frame_commands(CLI::App& app, context& ctx);  ///< decode, encode (cmd_frames.cpp)
+void add_serve_command(CLI::App& app, context& ctx);   ///< serve (cmd_serve.cpp)
+void add_robot_commands(CLI::App& app, context& ctx);  ///< joint, pose, trim, scan (cmd_robot.cpp)
+void add_ui_command(CLI::App& app, context& ctx);      ///< ui (cmd_ui.cpp, ui/)
 
 /** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
 std::string_view plain_message(std::string_view what);

@@ -1,32 +1,36 @@
-// rcb4 command-line tool: motion play|stop|resume|status|wait|list|show (the ROM program's motions, §8).
+// rcb4 command-line tool: motion play|stop|resume|status|wait|list|show (the ROM program's motions, §8);
+// motion buttons is in cmd_buttons.cpp.
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
 #include <rcb4/motion/disassemble.hpp>
+#include <rcb4/ops/layout.hpp>
 
 #include <unistd.h>
 
 namespace cli {
-namespace {
-
-/** Options the motion commands share. */
-struct motion_options {
-  std::string layout = "2.2";  ///< the HTH4 version that wrote the board's program
-  double timeout_s = 60;       ///< how long --wait / wait waits
-};
-
-const rcb4::rom_layout& layout_of(const motion_options& o) {
-  if (o.layout == "1.3") return rcb4::hth4_1_3;
-  if (o.layout == "2.0" || o.layout == "2.1") return rcb4::hth4_2_0;
-  return rcb4::hth4_2_2;
-}
 
 void add_layout(CLI::App* cmd, motion_options& o) {
   cmd->add_option("--layout", o.layout,
-                  "the HeartToHeart4 version that wrote the board's program: 2.2 (default; also later versions), "
-                  "2.0 or 2.1, 1.3. It sets where the motions start in ROM (protocol.md §8)")
-      ->check(CLI::IsMember({"1.3", "2.0", "2.1", "2.2"}));
+                  "the HeartToHeart4 version that wrote the board's program: auto (default: told from the ROM, "
+                  "where motion 1 and the main loop are), 2.2 (also later versions), 2.0 or 2.1, 1.3. It sets "
+                  "where the motions start in ROM (protocol.md §8)")
+      ->check(CLI::IsMember({"auto", "1.3", "2.0", "2.1", "2.2"}));
 }
+
+const rcb4::rom_layout& layout_for(session& s, const motion_options& o) {
+  if (o.layout == "1.3") return rcb4::hth4_1_3;
+  if (o.layout == "2.0" || o.layout == "2.1") return rcb4::hth4_2_0;
+  if (o.layout == "2.2") return rcb4::hth4_2_2;
+  const auto guess = s.run(rcb4::ops::detect_layout{});
+  if (!guess.layout)
+    throw failure(exit_board,
+                  fmt::format("cannot tell which HeartToHeart4 layout the board's ROM has: {}", guess.reason),
+                  "name it: --layout 2.2 (motion 1 at 0x000B80), --layout 2.0 or --layout 1.3 (at 0x000BB8)");
+  return *guess.layout;
+}
+
+namespace {
 
 CLI::Option* add_timeout(CLI::App* cmd, motion_options& o, std::string_view what) {
   return cmd->add_option("--timeout", o.timeout_s, fmt::format("seconds to wait{} (default 60)", what))
@@ -55,7 +59,8 @@ std::string state_text(const rcb4::ops::motion_state& st) {
 }
 
 /** Waits until no motion runs; returns the seconds waited and the last state. */
-std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options& o, const globals& g) {
+std::pair<double, rcb4::ops::motion_state> wait(session& s, const rcb4::rom_layout& layout, const motion_options& o,
+                                                const globals& g) {
   const bool tty = ::isatty(STDERR_FILENO) && !g.json;
   const auto start = std::chrono::steady_clock::now();
   const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
@@ -69,7 +74,7 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options
           fmt::print(stderr, "\r  motion {} running  {:5.1f} s  pc 0x{:06X} ",
                      m.motion ? fmt::format("{}", *m.motion) : "?", seconds(), m.program_counter);
       },
-      layout_of(o));
+      layout);
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
   // The board answered every poll, but the motion outlived the wait: say that, not "no reply".
   if (ec == rcb4::transport::transport_errc::timeout && last && last->running && seconds() >= o.timeout_s)
@@ -91,7 +96,10 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const motion_options
 }
 
 int play(session& s, unsigned n, bool release, bool and_wait, const motion_options& o, const globals& g) {
-  const auto& layout = layout_of(o);
+  const auto& layout = layout_for(s, o);
+  if (n > layout.motion_count)
+    throw usage_error(
+        fmt::format("motion number: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
   s.run(rcb4::ops::play_motion(n, layout, release ? rcb4::ops::servo_power::release : rcb4::ops::servo_power::keep));
   if (!and_wait) {
     if (g.json) {
@@ -105,7 +113,7 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
     return exit_ok;
   }
   if (!g.json) fmt::print("playing motion {} ({} layout)\n", n, layout.name);
-  const auto [t, st] = wait(s, o, g);
+  const auto [t, st] = wait(s, layout, o, g);
   if (g.json) {
     json j;
     j["played"] = n;
@@ -122,7 +130,7 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
 /** `motion show N`: the slot's code as the board runs it, poses in the robot's joints. */
 int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   namespace m = rcb4::motion;
-  const auto& layout = layout_of(o);
+  const auto& layout = layout_for(s, o);
   const auto where = m::slot_of(layout, static_cast<unsigned>(n));
   if (!where)
     throw usage_error(fmt::format("motion {}: the {} layout has motions 1-{}", n, layout.name, layout.motion_count));
@@ -233,10 +241,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                      "turn the servo outputs off while the program is suspended (KONDO's libraries do; "
                      "by default they keep holding, so the robot does not go limp between motions)");
   play_cmd->callback([&ctx, po] {
-    const auto& layout = layout_of(po->m);
-    if (po->n < 1 || po->n > layout.motion_count)
-      throw usage_error(
-          fmt::format("motion number: {} is outside 1..{} ({} layout)", po->n, layout.motion_count, layout.name));
+    if (po->n < 1 || po->n > 120) throw usage_error(fmt::format("motion number: {} is outside 1..120", po->n));
     ctx.action = [&ctx, po] {
       session s(ctx.g);
       return play(s, static_cast<unsigned>(po->n), po->release, po->wait, po->m, ctx.g);
@@ -267,7 +272,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   auto so = std::make_shared<motion_options>();
   add_layout(status, *so);
   on_device(status, ctx, [&ctx, so](session& s) {
-    const auto st = s.run(rcb4::ops::read_motion_state(layout_of(*so)));
+    const auto st = s.run(rcb4::ops::read_motion_state(layout_for(s, *so)));
     if (ctx.g.json)
       emit(state_json(st));
     else
@@ -279,7 +284,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   auto lo = std::make_shared<motion_options>();
   add_layout(list, *lo);
   on_device(list, ctx, [&ctx, lo](session& s) {
-    const auto& layout = layout_of(*lo);
+    const auto& layout = layout_for(s, *lo);
     const auto& m = robot_of(ctx.g);
     rcb4::ops::list_motions op(layout);
     progress bar("reading motion slots", layout.motion_count, ctx.g.json);
@@ -324,7 +329,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   add_timeout(wait_cmd, *wo, "");
   add_layout(wait_cmd, *wo);
   on_device(wait_cmd, ctx, [&ctx, wo](session& s) {
-    const auto [t, st] = wait(s, *wo, ctx.g);
+    const auto [t, st] = wait(s, layout_for(s, *wo), *wo, ctx.g);
     if (ctx.g.json) {
       json j = state_json(st);
       j["seconds"] = std::round(t * 10) / 10;
@@ -334,6 +339,8 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     }
     return exit_ok;
   });
+
+  add_button_commands(motion, ctx);
 }
 
 }  // namespace cli

@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/motion/buttons.hpp>
+
 #include <unistd.h>
 
 #include <cmath>
@@ -13,23 +15,15 @@ namespace {
 
 using namespace std::chrono_literals;
 
+/** The names of the buttons held in @p b, as `rcb4 motion buttons` takes them (motion/buttons.hpp). */
 std::vector<std::string> button_names(std::uint16_t b) {
-  static constexpr std::pair<rcb4::krr_button, std::string_view> names[] = {
-      {rcb4::krr_button::up, "up"},         {rcb4::krr_button::down, "down"},     {rcb4::krr_button::right, "right"},
-      {rcb4::krr_button::left, "left"},     {rcb4::krr_button::triangle, "tri"},  {rcb4::krr_button::cross, "cross"},
-      {rcb4::krr_button::circle, "circle"}, {rcb4::krr_button::square, "square"}, {rcb4::krr_button::s1, "S1"},
-      {rcb4::krr_button::s2, "S2"},         {rcb4::krr_button::s3, "S3"},         {rcb4::krr_button::s4, "S4"}};
   std::vector<std::string> out;
-  for (const auto& [bit, name] : names)
-    if (b & static_cast<std::uint16_t>(bit)) out.emplace_back(name);
+  for (const auto& n : rcb4::motion::button_names)
+    if (b & n.bit) out.emplace_back(n.name);
   return out;
 }
 
-std::string buttons_text(std::uint16_t b) {
-  std::string out;
-  for (const auto& n : button_names(b)) out += (out.empty() ? "" : "+") + n;
-  return out.empty() ? "none" : out;
-}
+std::string buttons_text(std::uint16_t b) { return rcb4::motion::buttons_text(b); }
 
 /** One reading of everything a KHR carries on its inputs. */
 struct reading {

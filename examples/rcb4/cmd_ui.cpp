@@ -20,7 +20,7 @@ struct ui_options {
   std::string listen = "127.0.0.1:8080";
   std::string token;
   std::string poses = "poses";
-  std::string layout = "2.2";
+  std::string layout = "auto";
   double speed = 90;
 };
 
@@ -99,9 +99,13 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
   ui::hub h(m, limits, [&server](ui::client_id to, std::string text) { server->send(to, std::move(text)); });
   ui::loop_options lo;
   lo.poses = o.poses;
-  lo.layout = o.layout == "1.3"                          ? &rcb4::hth4_1_3
-              : (o.layout == "2.0" || o.layout == "2.1") ? &rcb4::hth4_2_0
-                                                         : &rcb4::hth4_2_2;
+  try {
+    lo.layout = &layout_for(s, motion_options{o.layout});
+  } catch (const failure& f) {  // a board without motion 1: the page still works; say what motions will assume
+    if (f.exit != exit_board) throw;
+    fmt::print(stderr, "rcb4 ui: {}; motions are played as HTH4 2.2+ (--layout names another)\n", f.what());
+    lo.layout = &rcb4::hth4_2_2;
+  }
   lo.device = s.where();
   h.set_hello(ui::hello_text(m, s, lo, limits));
 
@@ -165,8 +169,10 @@ void add_ui_command(CLI::App& app, context& ctx) {
   cmd->add_option("--speed", o->speed, "the fastest a page may move a joint, degrees per second (default 90)")
       ->type_name("DEG_PER_S")
       ->check(CLI::Range(1.0, 1000.0));
-  cmd->add_option("--layout", o->layout, "the HeartToHeart4 version that wrote the motions (see motion play)")
-      ->check(CLI::IsMember({"1.3", "2.0", "2.1", "2.2"}));
+  cmd->add_option("--layout", o->layout,
+                  "the HeartToHeart4 version that wrote the motions: auto (default: told from the ROM), 2.2, 2.0, "
+                  "2.1, 1.3 (see motion play)")
+      ->check(CLI::IsMember({"auto", "1.3", "2.0", "2.1", "2.2"}));
   cmd->footer(
       "Prints the URL as the first line of stdout and serves until SIGINT/SIGTERM (exit 0).\n"
       "Open it in a browser on this machine, or from another one over SSH:\n"

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <rcb4/ops/io.hpp>
+#include <rcb4/ops/layout.hpp>
 #include <rcb4/ops/memory.hpp>
 #include <rcb4/ops/motion.hpp>
 #include <rcb4/ops/operation.hpp>

@@ -308,8 +308,11 @@ for args in [["servo", "list"], ["servo", "get", "0"], ["servo", "move", "0=7500
 short = StandIn(mode="short")
 rc, out, err = run("--device", short.path, "--baud", "1250000", "read", "ram", "0", "4")
 check(rc == 1, f"replies of the wrong length: exit 1, a board/line problem (rc {rc}: {err[:200]!r})")
-rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3")
+rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3", "--layout", "2.2")
 check(rc == 1 and "holds no program" in err, f"stand-in with an erased ROM: motion play refused (rc {rc}: {err[:160]!r})")
+rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3")
+check(rc == 1 and "cannot tell which HeartToHeart4 layout" in err,
+      f"stand-in with an erased ROM: its layout is not guessed (rc {rc}: {err[:160]!r})")
 late = StandIn(mode="late")
 rc, out, err = run("--device", late.path, "--baud", "115200", "--timeout", "1000", "ping")
 check(rc == 0 and " ms" in out and " us" not in out, f"a late reply is timed in ms, not 300000 us ({out!r})")
