@@ -123,7 +123,7 @@ constexpr bool never_fires(const vector_entry& e) noexcept { return e.cond == co
 
 /** A table as read: its entries in order, and why the walk ended. */
 struct vector_table {
-  std::vector<vector_entry> entries;  ///< up to the EOF entry (a never-firing EOF entry left out)
+  std::vector<vector_entry> entries;  ///< up to the EOF entry (never-firing entries left out)
   bool ended = false;                 ///< an EOF entry was found
   std::string problem;                ///< when the walk stopped on bytes that are no entry (erased ROM…)
 };
@@ -138,7 +138,7 @@ inline vector_table decode_vector_table(std::span<const std::uint8_t> bytes) {
                   (bytes[j * vector_entry::size] == 0xFF ? ": erased" : "");
       return t;
     }
-    if (!(e->last && never_fires(*e))) t.entries.push_back(*e);
+    if (!never_fires(*e)) t.entries.push_back(*e);  // it means nothing but, with EOF, the end
     if (e->last) {
       t.ended = true;
       return t;
