@@ -4,8 +4,13 @@
 //   - a profile_error's text starts with the source name;
 //   - an accepted model passes model::make's checks again (its joints, groups and motions);
 //   - an accepted pose names only joints of the model, each once, and written back as JSON it
-//     reads back to the same joints.
+//     reads back to the same joints;
+//   - an accepted motion file, written back as YAML, reads back to the same steps (when the input
+//     is valid UTF-8: the writer replaces invalid bytes); to_program gives a program or a problem,
+//     and a program that assembles reads back (disassemble, lift, from_program) to the same bytes.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/profile.hpp>
 
 #include <cstddef>
@@ -16,6 +21,52 @@
 namespace {
 void check(bool ok) {
   if (!ok) __builtin_trap();
+}
+
+bool valid_utf8(std::string_view s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
+    if (n == 0 || i + n > s.size()) return false;
+    for (std::size_t k = 1; k < n; ++k)
+      if ((static_cast<unsigned char>(s[i + k]) >> 6) != 2) return false;
+    i += n;
+  }
+  return true;
+}
+
+void motion_file(std::string_view text, const rcb4::robot::model& khr) {
+  using namespace rcb4::robot;
+  motion_document d;
+  try {
+    // Pose files resolve under a folder that does not exist: the input reaches no real file by a relative path.
+    d = parse_motion(text, "fuzz-motion.yaml", khr, "/nonexistent-rcb4-fuzz");
+  } catch (const profile_error&) {
+    return;
+  }
+  check(d.where.size() == d.steps.size() && !d.steps.empty());
+  if (valid_utf8(text)) {
+    try {
+      const auto again = parse_motion(motion_yaml(d, "c"), "back.yaml", khr, "/nonexistent-rcb4-fuzz");
+      check(again.steps == d.steps && again.period == d.period);
+    } catch (const profile_error&) {
+      check(false);
+    }
+  }
+  const auto c = to_program(d, khr, rcb4::hth4_2_2, d.period);
+  if (!ok(c)) return;
+  const rcb4::motion::slot where{rcb4::rom_address::make(0x0B80).value(), 2048};
+  const auto b = rcb4::motion::assemble(std::get<compiled_motion>(c).program, where);
+  if (!rcb4::motion::ok(b)) return;
+  const auto& bytes = std::get<std::vector<std::uint8_t>>(b);
+  const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where));
+  check(rcb4::motion::ok(p));
+  const auto back = to_program(from_program(std::get<rcb4::motion::program>(p), khr, rcb4::hth4_2_2, d.period), khr,
+                               rcb4::hth4_2_2, d.period);
+  // A pose of a joint beyond its limit cannot come out of to_program: the same limits pass again.
+  check(ok(back));
+  const auto b2 = rcb4::motion::assemble(std::get<compiled_motion>(back).program, where);
+  check(rcb4::motion::ok(b2) && std::get<std::vector<std::uint8_t>>(b2) == bytes);
 }
 }  // namespace
 
@@ -42,6 +93,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < p.joints.size(); ++i) check(back.joints[i].first == p.joints[i].first);
   } catch (const profile_error& e) {
     check(std::string_view(e.what()).substr(0, 9) == "fuzz.json");
+  } catch (...) {
+    check(false);
+  }
+  try {
+    motion_file(text, khr);
   } catch (...) {
     check(false);
   }

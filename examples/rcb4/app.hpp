@@ -212,6 +212,9 @@ void add_sensor_commands(CLI::App& app, context& ctx);     ///< sensors, monitor
 void add_motion_commands(CLI::App& app, context& ctx);     ///< motion … (cmd_motion.cpp)
 void add_button_commands(CLI::App* motion, context& ctx);  ///< motion buttons … (cmd_buttons.cpp)
 
+void add_motion_file_commands(CLI::App* motion, context& ctx);  ///< motion pull|push|erase (cmd_motion_files.cpp)
+/** The buttons (or other vector entries) of ROM's and RAM's table that go to @p address (cmd_buttons.cpp). */
+std::vector<std::string> entries_playing(session& s, std::uint32_t address);
 /** Options the motion commands share (cmd_motion.cpp). */
 struct motion_options {
   std::string layout = "auto";  ///< the HTH4 version that wrote the board's program, or auto
@@ -227,6 +230,7 @@ void add_frame_commands(CLI::App& app, context& ctx);  ///< decode, encode (cmd_
 void add_serve_command(CLI::App& app, context& ctx);   ///< serve (cmd_serve.cpp)
 void add_robot_commands(CLI::App& app, context& ctx);  ///< joint, pose, trim, scan (cmd_robot.cpp)
 void add_ui_command(CLI::App& app, context& ctx);      ///< ui (cmd_ui.cpp, ui/)
+void add_rom_commands(CLI::App& app, context& ctx);    ///< rom backup|restore (cmd_rom.cpp)
 
 /** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
 std::string_view plain_message(std::string_view what);

@@ -178,6 +178,19 @@ std::uint16_t buttons_of(const std::string& text) {
 
 }  // namespace
 
+std::vector<std::string> entries_playing(session& s, std::uint32_t address) {
+  std::vector<std::string> out;
+  const auto t = read_tables(s);
+  for (const auto* table : {&t.rom, &t.ram})
+    for (const auto& e : table->entries)
+      if (e.target.value() == address) {
+        const auto b = e.buttons();
+        std::string what = b ? mo::buttons_text(*b) : fmt::format("an entry on {}", operand_text(e.dst));
+        if (std::find(out.begin(), out.end(), what) == out.end()) out.push_back(std::move(what));
+      }
+  return out;
+}
+
 void add_button_commands(CLI::App* motion, context& ctx) {
   auto* buttons = motion->add_subcommand(
       "buttons", "which remote (KRR) button plays which motion: the vector-jump table, in RAM and ROM");

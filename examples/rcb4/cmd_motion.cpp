@@ -340,6 +340,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     return exit_ok;
   });
 
+  add_motion_file_commands(motion, ctx);
   add_button_commands(motion, ctx);
 }
 

@@ -173,6 +173,7 @@ int main(int argc, char** argv) {
   cli::add_servo_commands(app, ctx);
   cli::add_sensor_commands(app, ctx);
   cli::add_motion_commands(app, ctx);
+  cli::add_rom_commands(app, ctx);
   cli::add_bench_command(app, ctx);
   cli::add_host_commands(app, ctx);
   cli::add_frame_commands(app, ctx);

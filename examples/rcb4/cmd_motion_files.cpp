@@ -1,0 +1,348 @@
+// rcb4 command-line tool: motion pull N FILE, motion push FILE N, motion erase N: ROM motion slots
+// to and from motion files (rcb4/robot/motion_file.hpp), with a backup of what a write replaces.
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/robot/motion_file.hpp>
+
+#include <fmt/format.h>
+
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+
+namespace cli {
+namespace {
+
+namespace mo = rcb4::motion;
+namespace ro = rcb4::robot;
+using rcb4::ops::memory;
+
+/** The slot of motion @p n in @p layout; a usage error outside it. */
+mo::slot slot_for(const rcb4::rom_layout& layout, long long n) {
+  const auto where = n >= 1 ? mo::slot_of(layout, static_cast<unsigned>(n)) : std::nullopt;
+  if (!where || n > layout.motion_count)
+    throw usage_error(fmt::format("N: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
+  return *where;
+}
+
+/** @p size bytes of ROM from @p at, with a progress line on a terminal. */
+std::vector<std::uint8_t> read_rom(session& s, std::uint32_t at, std::size_t size, const std::string& what,
+                                   const globals& g) {
+  rcb4::ops::read_memory op(memory::rom, at, size);
+  progress bar(what, size, g.json);
+  rcb4::transport::error_code ec;
+  std::size_t done = 0;
+  s.run_steps(op, ec, [&] { bar.update(done = std::min(size, done + rcb4::ops::max_read)); });
+  bar.finish();
+  if (ec) throw rcb4::transport::system_error(ec);
+  return op.value();
+}
+
+/** Writes @p bytes at @p at, reads them back and compares; a failure names the first differing address. */
+void write_rom_checked(session& s, std::uint32_t at, std::span<const std::uint8_t> bytes, const std::string& what,
+                       const globals& g) {
+  rcb4::ops::write_memory op(memory::rom, at, bytes);
+  progress bar(what, bytes.size(), g.json);
+  rcb4::transport::error_code ec;
+  s.run_steps(op, ec, [&] { bar.update(op.value()); });
+  bar.finish();
+  if (ec)
+    throw failure(explain(ec, "").exit,
+                  fmt::format("writing ROM 0x{:06X} failed after {} of {}: {}", at, op.value(),
+                              plural(bytes.size(), "byte"), plain_message(rcb4::transport::system_error(ec).what())),
+                  "the slot may now hold part of the new motion: the backup file puts the old one back");
+  const auto back = read_rom(s, at, bytes.size(), "reading back", g);
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    if (back[i] != bytes[i])
+      throw failure(exit_board,
+                    fmt::format("ROM 0x{:06X} reads back 0x{:02X}, 0x{:02X} was written", at + i, back[i], bytes[i]),
+                    "the board may not accept ROM writes there; the backup file puts the old motion back");
+}
+
+/** The bytes of the code the board reaches in @p l (from the slot start, in address order). */
+std::size_t code_size(const mo::listing& l) {
+  if (l.code.empty()) return 0;
+  return l.code.back().address + l.code.back().bytes.size() - l.where.address.value();
+}
+
+/** The board's output period (config bits 4-5). */
+rcb4::output_period board_period(session& s) { return s.run(rcb4::ops::read_config{}).period; }
+
+std::string now_stamp() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  ::localtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y%m%d-%H%M%S", &tm);
+  return b;
+}
+
+/** Saves @p bytes (a slot's old contents) to @p path, or to motion-N-DATE.bin when it is empty. */
+std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, unsigned n) {
+  if (path.empty()) path = fmt::format("motion-{}-{}.bin", n, now_stamp());
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  out.flush();
+  if (!out)
+    throw failure(
+        exit_usage,
+        fmt::format("cannot write the backup {}: {} (nothing was written to the board)", path, std::strerror(errno)),
+        "--backup FILE names another place");
+  return path;
+}
+
+/** Refuses to write while the ROM program runs a motion (the board would fetch the bytes being replaced). */
+void require_idle(session& s, const rcb4::rom_layout& layout) {
+  const auto st = s.run(rcb4::ops::read_motion_state(layout));
+  if (st.running)
+    throw failure(exit_board,
+                  fmt::format("{} is running: the board would run the bytes being written",
+                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program")),
+                  "rcb4 motion wait, or rcb4 motion stop, then write");
+}
+
+/** Warns when a remote button plays motion @p n (erased or changed, a press plays what is there now). */
+void warn_buttons(session& s, const mo::slot& where, unsigned n, std::string_view what, const globals& g) {
+  const auto b = entries_playing(s, where.address.value());
+  if (!b.empty() && !g.json) fmt::print(stderr, "note: {} plays motion {}: {}\n", fmt::join(b, ", "), n, what);
+}
+
+struct pull_options {
+  motion_options m;
+  long long n = 0;
+  std::string file;
+  bool force = false;
+};
+
+int pull(session& s, const pull_options& o, const globals& g) {
+  const auto& layout = layout_for(s, o.m);
+  const auto where = slot_for(layout, o.n);
+  const auto n = static_cast<unsigned>(o.n);
+  if (std::filesystem::exists(o.file) && !o.force)
+    throw usage_error(fmt::format("FILE: {} exists (--force replaces it)", o.file));
+  const auto bytes = read_rom(s, where.address.value(), where.size, fmt::format("reading motion {}", n), g);
+  if (bytes.empty() || bytes[0] == 0xFF)
+    throw failure(exit_board, fmt::format("motion {} (0x{:06X}) is empty: erased ROM", n, where.address.value()),
+                  "rcb4 motion list shows the used slots");
+  const auto l = mo::disassemble(bytes, where);
+  if (!l.problems.empty())
+    throw failure(exit_board, fmt::format("motion {}: {}", n, l.problems.front()),
+                  fmt::format("rcb4 motion show {} lists the code the board reaches", n));
+  const auto p = mo::lift(l);
+  if (!mo::ok(p))
+    throw failure(exit_board,
+                  fmt::format("motion {} is code a motion file cannot say: {}", n, std::get<mo::failure>(p).message),
+                  fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n,
+                              where.address.value(), code_size(l)));
+  const auto period = board_period(s);
+  const auto& robot = robot_of(g);
+  auto d = ro::from_program(std::get<mo::program>(p), robot, layout, period);
+  d.name = std::string(robot.motion(n));
+  // Checked as push will check it: a pose beyond a limit pulls, but does not push back as it is.
+  const auto again = ro::to_program(d, robot, layout, period);
+  std::string comment = fmt::format(
+      "motion {} of the board (0x{:06X}, {} layout), pulled by rcb4 on {}\n"
+      "rcb4 motion push {} {} writes it back",
+      n, where.address.value(), layout.name, now_stamp(), o.file, n);
+  try {
+    ro::save_motion(o.file, d, comment);
+  } catch (const ro::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  std::size_t poses = 0;
+  long long ms = 0;
+  for (const auto& st : d.steps)
+    if (const auto* mp = std::get_if<ro::motion_pose>(&st)) ++poses, ms += mp->time.count();
+  const std::string beyond = ro::ok(again) ? std::string() : std::get<ro::problem>(again).message;
+  if (g.json) {
+    emit(json{{"pulled", n},
+              {"file", o.file},
+              {"layout", layout.name},
+              {"address", where.address.value()},
+              {"bytes", code_size(l)},
+              {"steps", d.steps.size()},
+              {"poses", poses},
+              {"pose_ms", ms},
+              {"period_ms", rcb4::milliseconds(period)},
+              {"problem", beyond.empty() ? json(nullptr) : json(beyond)}});
+  } else {
+    fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({:.2f} s of moves at {} ms frames) -> {}\n", n,
+               where.address.value(), layout.name, code_size(l), d.steps.size(), plural(poses, "pose"),
+               static_cast<double>(ms) / 1000, rcb4::milliseconds(period), o.file);
+    if (!beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", beyond);
+  }
+  return exit_ok;
+}
+
+struct push_options {
+  motion_options m;
+  std::string file, backup;
+  long long n = 0;
+  bool rescale = false, dry_run = false;
+};
+
+/** The bytes FILE stands for at @p where: a motion file assembled, or a .bin backup as it is. */
+std::vector<std::uint8_t> bytes_of(session& s, const push_options& o, const rcb4::rom_layout& layout,
+                                   const mo::slot& where, std::vector<std::string>& notes, std::string& summary,
+                                   const globals& g) {
+  if (std::filesystem::path(o.file).extension() == ".bin") {
+    std::ifstream in(o.file, std::ios::binary);
+    if (!in) throw usage_error(fmt::format("FILE: {} cannot be read ({})", o.file, std::strerror(errno)));
+    std::vector<std::uint8_t> b{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    if (b.empty() || b.size() > where.size)
+      throw usage_error(
+          fmt::format("FILE: {} holds {}; a slot takes 1..{}", o.file, plural(b.size(), "byte"), where.size));
+    // Only what the board reaches: an erased tail stays unwritten.
+    const auto l = mo::disassemble(b, where);
+    if (b[0] != 0xFF && !l.problems.empty())
+      throw usage_error(fmt::format("FILE: {} is not motion code for 0x{:06X}: {}", o.file, where.address.value(),
+                                    l.problems.front()));
+    summary = b[0] == 0xFF ? "an empty slot" : fmt::format("{} reachable frames", l.code.size());
+    return b;
+  }
+  ro::motion_document d;
+  try {
+    d = ro::load_motion(o.file, robot_of(g));
+  } catch (const ro::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  const auto c = ro::to_program(d, robot_of(g), layout, board_period(s), o.rescale);
+  if (!ro::ok(c))
+    throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<ro::problem>(c).message));
+  const auto& cm = std::get<ro::compiled_motion>(c);
+  notes = cm.notes;
+  const auto b = mo::assemble(cm.program, where);
+  if (!mo::ok(b))
+    throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<mo::failure>(b).message));
+  std::size_t poses = 0;
+  unsigned frames = 0;
+  for (const auto& st : cm.program.steps)
+    if (const auto* p = std::get_if<mo::pose>(&st)) ++poses, frames += p->time.value();
+  summary = fmt::format("{} steps, {} ({:.2f} s of moves)", cm.program.steps.size(), plural(poses, "pose"),
+                        frames * rcb4::milliseconds(cm.period) / 1000.0);
+  return std::get<std::vector<std::uint8_t>>(b);
+}
+
+int push(session& s, const push_options& o, const globals& g) {
+  const auto& layout = layout_for(s, o.m);
+  const auto where = slot_for(layout, o.n);
+  const auto n = static_cast<unsigned>(o.n);
+  std::vector<std::string> notes;
+  std::string summary;
+  const auto bytes = bytes_of(s, o, layout, where, notes, summary, g);
+  if (!g.json)
+    for (const auto& note : notes) fmt::print(stderr, "note: {}\n", note);
+  if (o.dry_run) {
+    if (g.json)
+      emit(json{{"dry_run", true},
+                {"motion", n},
+                {"address", where.address.value()},
+                {"bytes", bytes.size()},
+                {"hex", fmt::format("{}", rcb4::hex_view{bytes})},
+                {"notes", notes}});
+    else
+      fmt::print("would write {} to motion {} (0x{:06X}, {} layout): {}\n{}\n", plural(bytes.size(), "byte"), n,
+                 where.address.value(), layout.name, summary, rcb4::hex_view{bytes});
+    return exit_ok;
+  }
+  require_idle(s, layout);
+  const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
+  if (std::equal(bytes.begin(), bytes.end(), old.begin())) {
+    if (g.json)
+      emit(json{{"pushed", n}, {"address", where.address.value()}, {"bytes", bytes.size()}, {"unchanged", true}});
+    else
+      fmt::print("motion {} (0x{:06X}) already holds these {}: nothing written\n", n, where.address.value(),
+                 plural(bytes.size(), "byte"));
+    return exit_ok;
+  }
+  const auto saved = backup(old, o.backup, n);
+  write_rom_checked(s, where.address.value(), bytes, fmt::format("writing motion {}", n), g);
+  warn_buttons(s, where, n, "a press plays the new one", g);
+  if (g.json) {
+    emit(json{{"pushed", n},
+              {"address", where.address.value()},
+              {"layout", layout.name},
+              {"bytes", bytes.size()},
+              {"unchanged", false},
+              {"backup", saved},
+              {"notes", notes}});
+  } else {
+    fmt::print("wrote {} to motion {} (0x{:06X}..0x{:06X}, {} layout) and read them back: {}\n",
+               plural(bytes.size(), "byte"), n, where.address.value(), where.address.value() + bytes.size() - 1,
+               layout.name, summary);
+    fmt::print("the slot's old bytes are in {} (rcb4 motion push {} {} puts them back)\n", saved, saved, n);
+  }
+  return exit_ok;
+}
+
+int erase(session& s, const push_options& o, const globals& g) {
+  const auto& layout = layout_for(s, o.m);
+  const auto where = slot_for(layout, o.n);
+  const auto n = static_cast<unsigned>(o.n);
+  require_idle(s, layout);
+  const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
+  if (std::all_of(old.begin(), old.end(), [](std::uint8_t b) { return b == 0xFF; })) {
+    if (g.json)
+      emit(json{{"erased", n}, {"address", where.address.value()}, {"unchanged", true}});
+    else
+      fmt::print("motion {} (0x{:06X}) is already empty: nothing written\n", n, where.address.value());
+    return exit_ok;
+  }
+  const auto saved = backup(old, o.backup, n);
+  const std::vector<std::uint8_t> erased(where.size, 0xFF);
+  write_rom_checked(s, where.address.value(), erased, fmt::format("erasing motion {}", n), g);
+  warn_buttons(s, where, n, "a press now stops the board's program (rcb4 motion buttons clear)", g);
+  if (g.json)
+    emit(json{{"erased", n}, {"address", where.address.value()}, {"unchanged", false}, {"backup", saved}});
+  else
+    fmt::print(
+        "erased motion {} (0x{:06X}, {} bytes of 0xFF, read back); the old bytes are in {} "
+        "(rcb4 motion push {} {} puts them back)\n",
+        n, where.address.value(), where.size, saved, saved, n);
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_motion_file_commands(CLI::App* motion, context& ctx) {
+  auto pl = std::make_shared<pull_options>();
+  auto* pull_cmd = motion->add_subcommand(
+      "pull", "motion N to a motion file (YAML: the profile's joints in degrees, times in ms; see the README)");
+  pull_cmd->add_option("N", pl->n, "the motion's number")->required()->check(int_range(1, 120));
+  pull_cmd->add_option("FILE", pl->file, "the motion file to write (.yaml or .yml)")->required();
+  pull_cmd->add_flag("--force", pl->force, "replace FILE when it exists");
+  add_layout(pull_cmd, pl->m);
+  pull_cmd->callback([&ctx, pl] {
+    const auto ext = std::filesystem::path(pl->file).extension();
+    if (ext != ".yaml" && ext != ".yml")
+      throw usage_error(fmt::format("FILE: {} does not end in .yaml or .yml", pl->file));
+    ctx.action = [&ctx, pl] {
+      session s(ctx.g);
+      return pull(s, *pl, ctx.g);
+    };
+  });
+
+  auto pu = std::make_shared<push_options>();
+  auto* push_cmd = motion->add_subcommand(
+      "push", "write a motion file (or a .bin backup) into motion N: checked, the old bytes backed up, read back");
+  push_cmd->add_option("FILE", pu->file, "a motion file (.yaml/.yml), or a backup (.bin) to put back")->required();
+  push_cmd->add_option("N", pu->n, "the motion's number")->required()->check(int_range(1, 120));
+  push_cmd->add_option("--backup", pu->backup, "where the slot's old bytes go (default: motion-N-DATE.bin here)");
+  push_cmd->add_flag("--rescale", pu->rescale,
+                     "a file made for another output period: keep its times in ms (frames of the board's period)");
+  push_cmd->add_flag("--dry-run", pu->dry_run, "check and assemble, print the bytes, write nothing");
+  add_layout(push_cmd, pu->m);
+  on_device(push_cmd, ctx, [&ctx, pu](session& s) { return push(s, *pu, ctx.g); });
+
+  auto er = std::make_shared<push_options>();
+  auto* erase_cmd =
+      motion->add_subcommand("erase", "empty motion N (0xFF, as erased ROM reads), the old bytes backed up first");
+  erase_cmd->add_option("N", er->n, "the motion's number")->required()->check(int_range(1, 120));
+  erase_cmd->add_option("--backup", er->backup, "where the slot's old bytes go (default: motion-N-DATE.bin here)");
+  add_layout(erase_cmd, er->m);
+  on_device(erase_cmd, ctx, [&ctx, er](session& s) { return erase(s, *er, ctx.g); });
+}
+
+}  // namespace cli

@@ -1,0 +1,195 @@
+#!/usr/bin/env python3
+# Motion files and ROM images through the rcb4 tool as a robot owner uses them: pull a motion into
+# YAML, write one by hand and push it (the bytes checked against ones written by hand from
+# protocol.md), play it, pull it back, erase it and put the backup back, a whole ROM backed up and
+# restored; and what must be refused: poses beyond limits, another output period, a running
+# motion, damaged images, boards that do not keep what is written, die mid-transfer or are silent.
+#   motion_files_test.py RCB4
+# SPDX-License-Identifier: BSL-1.0
+import glob
+import json
+import os
+import sys
+import tempfile
+import zlib
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import check, finish, tool
+from standin import StandIn
+
+RCB4 = sys.argv[1]
+run, serve = tool(RCB4)
+work = tempfile.mkdtemp(prefix="rcb4-motion-files-")
+os.chdir(work)  # backups land in the working directory, as they would for a user
+
+
+def write(name, text):
+    with open(name, "w") as f:
+        f.write(text)
+
+
+def rom(on, address, n):
+    rc, out, err = run("--json", *on, "read", "rom", hex(address), str(n))
+    return bytes(json.loads(out)["bytes"]) if rc == 0 else b""
+
+
+# Counter 3, left_knee to +30 degrees in 300 ms, three times; again while UP is held.
+write("knee.yaml", """# three knee bends
+robot: KHR-3HV
+period_ms: 15
+steps:
+  - set_counter: 3
+  - label: again
+  - pose: {left_knee: 30}
+    time_ms: 300
+  - loop: again
+  - if_buttons: up
+    goto: again
+  - end
+""")
+# The same at motion 5 (0x002B80), written by hand from protocol.md §4-§5 and motions.md §1.
+knee_at_5 = bytes.fromhex(
+    "08 00 02 57 04 00 03 68"            # MOV 3 -> RAM 0x0457
+    "0B 10 00 00 01 00 00 14 C5 20 15"   # CONST ICS 16 = 8389 (+30 deg), 20 frames, flags set
+    "08 07 02 57 04 00 01 6D"            # SUB 1 from 0x0457
+    "07 0B 88 2B 00 04 C9"               # JUMP 0x002B88 when Z = 0
+    "09 07 82 50 03 00 01 00 E6"         # SUB S 0x0001 (UP) from 0x0350
+    "07 0B 88 2B 00 05 CA"               # JUMP 0x002B88 when Z = 1
+    "03 0D 10")                          # RETURN
+
+rom_file = os.path.join(work, "robot.rom")
+with serve("--rom", rom_file, "--period", "15") as dev:
+    on = ["--device", dev]
+    # Pull: the demo's motion 2 in joints and milliseconds.
+    rc, out, err = run(*on, "motion", "pull", "2", "wave.yaml")
+    text = open("wave.yaml").read() if os.path.exists("wave.yaml") else ""
+    check(rc == 0 and "motion 2 (0x001380, HTH4 2.2+ layout): 62 bytes, 6 steps, 5 poses" in out and "-> wave.yaml" in out,
+          f"motion pull 2 ({rc}: {out.strip()!r} {err.strip()!r})")
+    check('name: "wave"' in text and "period_ms: 15" in text
+          and "- pose: {right_shoulder_pitch: 67.5, right_shoulder_roll: 101.25}\n    time_ms: 300" in text,
+          f"the pulled file in degrees and ms ({text[:300]!r})")
+    check("would not push back" in err and "right_shoulder_roll: 101.25 degrees is beyond its upper limit 100" in err,
+          f"pull says a pose lies beyond the profile's limit ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "pull", "2", "wave.yaml")
+    check(rc == 2 and "exists (--force replaces it)" in err, f"pull does not overwrite a file ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "pull", "9", "empty.yaml")
+    check(rc == 1 and "is empty" in err and not os.path.exists("empty.yaml"), f"pull of an empty slot: exit 1 ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "pull", "2", "wave.txt")
+    check(rc == 2 and ".yaml" in err, f"pull to a .txt: exit 2 ({rc}: {err.strip()!r})")
+
+    # A pose beyond a limit: refused, nothing written, no backup made.
+    rc, out, err = run(*on, "motion", "push", "wave.yaml", "5")
+    check(rc == 2 and "step 1 (wave.yaml:" in err and "beyond its upper limit 100" in err and "nothing was written" in err,
+          f"push of a pose beyond a limit: exit 2 ({rc}: {err.strip()!r})")
+    check(rom(on, 0x2B80, 4) == b"\xff" * 4 and not glob.glob("motion-5-*.bin"), "nothing written, no backup made")
+
+    # Push the hand-written file: the bytes by hand, the old (erased) slot backed up.
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "5")
+    check(rc == 0 and "wrote 53 bytes to motion 5 (0x002B80..0x002BB4" in out and "read them back" in out
+          and "6 steps, 1 pose (0.30 s of moves)" in out, f"motion push knee.yaml 5 ({rc}: {out.strip()!r} {err.strip()!r})")
+    check(rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, "ROM 0x002B80 holds the bytes written by hand")
+    backups = glob.glob("motion-5-*.bin")
+    check(len(backups) == 1 and open(backups[0], "rb").read() == b"\xff" * 2048,
+          f"the old slot (2,048 bytes of erased ROM) backed up ({backups})")
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "5")
+    check(rc == 0 and "already holds these 53 bytes: nothing written" in out, f"the same again: nothing written ({rc}: {out.strip()!r})")
+    rc, out, err = run("--json", *on, "motion", "push", "knee.yaml", "6", "--dry-run")
+    j = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and j.get("bytes") == 53 and rom(on, 0x3380, 1) == b"\xff", f"--dry-run writes nothing ({rc}: {out.strip()[:120]!r})")
+
+    # Play it: the knee ends at +30 degrees.
+    rc, out, err = run(*on, "motion", "play", "5", "--wait", "--timeout", "10")
+    check(rc == 0 and "done after" in out, f"motion play 5 --wait ({rc}: {out.strip()!r} {err.strip()!r})")
+    rc, out, err = run("--json", *on, "joint", "list")
+    knee = [x for x in json.loads(out) if x["name"] == "left_knee"][0] if rc == 0 else {}
+    check(abs(knee.get("degrees", 99) - 30) < 0.1, f"left_knee at +30 deg after the motion ({knee.get('degrees')})")
+
+    # Pulled back: the same steps, pushed again: the same bytes.
+    rc, out, err = run(*on, "motion", "pull", "5", "knee-back.yaml")
+    back = open("knee-back.yaml").read() if rc == 0 else ""
+    check(rc == 0 and "- pose: {left_knee: 30}\n    time_ms: 300" in back and "- loop: L2B88" in back
+          and '- if_buttons: "up"\n    goto: L2B88' in back and err == "", f"pull 5: the file written by hand, back ({back[-200:]!r} {err!r})")
+    rc, out, err = run(*on, "motion", "push", "knee-back.yaml", "5")
+    check(rc == 0 and "nothing written" in out, f"the pulled file assembles to the same bytes ({rc}: {out.strip()!r})")
+
+    # Another output period: refused, or rescaled on request.
+    write("knee10.yaml", open("knee.yaml").read().replace("period_ms: 15", "period_ms: 10"))
+    rc, out, err = run(*on, "motion", "push", "knee10.yaml", "6")
+    check(rc == 2 and "made for 10 ms frames" in err and "--rescale" in err, f"a file of 10 ms frames on a 15 ms board ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "knee10.yaml", "6", "--rescale", "--backup", "six.bin")
+    check(rc == 0 and "times kept in milliseconds" in err and "300 ms is 20 frames" not in err,
+          f"--rescale: 300 ms stays 300 ms ({rc}: {err.strip()!r})")
+    check(rom(on, 0x3380 + 8 + 7, 1) == bytes([20]) and os.path.exists("six.bin"), "20 frames of 15 ms, the backup where --backup says")
+
+    # A running motion is not written over.
+    run(*on, "motion", "play", "2")
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "7")
+    check(rc == 1 and "is running" in err and rom(on, 0x3B80, 1) == b"\xff", f"push while motion 2 runs: exit 1 ({rc}: {err.strip()!r})")
+    run(*on, "motion", "wait", "--timeout", "5")
+
+    # Erase, with a button on the slot; then the backup put back.
+    run(*on, "motion", "buttons", "set", "left", "5")
+    rc, out, err = run(*on, "motion", "erase", "5", "--backup", "five.bin")
+    check(rc == 0 and "erased motion 5" in out and "left plays motion 5" in err and rom(on, 0x2B80, 8) == b"\xff" * 8,
+          f"motion erase 5 ({rc}: {out.strip()!r} {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "list")
+    check(rc == 0 and "0x02B80" not in out, "motion list no longer shows 5")
+    rc, out, err = run(*on, "motion", "push", "five.bin", "5")
+    check(rc == 0 and rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, f"the backup put back ({rc}: {out.strip()!r} {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "erase", "9")
+    check(rc == 0 and "already empty" in out, f"erase of an empty slot writes nothing ({rc}: {out.strip()!r})")
+
+    # Mistakes in files: named with file and line, exit 2.
+    write("bad.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {left_kneee: 3}\n    time_ms: 10\n")
+    rc, out, err = run(*on, "motion", "push", "bad.yaml", "8")
+    check(rc == 2 and "bad.yaml:4:12: no joint of KHR-3HV is called 'left_kneee'" in err, f"an unknown joint ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "missing.yaml", "8")
+    check(rc == 2 and "missing.yaml" in err, f"a missing file ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "121")
+    check(rc == 2, f"motion 121 ({rc}: {err.strip()!r})")
+
+    # The whole ROM: backed up with a CRC-32 (checked here with zlib, not the tool), restored.
+    rc, out, err = run(*on, "rom", "backup", "all.bin")
+    image = open("all.bin", "rb").read() if rc == 0 else b""
+    crc = open("all.bin.crc32").read().split() if os.path.exists("all.bin.crc32") else [""]
+    check(rc == 0 and len(image) == 262144 and crc[0] == "%08x" % zlib.crc32(image) and image[0x2B80:0x2B80 + 53] == knee_at_5,
+          f"rom backup: 262,144 bytes and their CRC-32 ({rc}: {out.strip()!r} {crc})")
+    run(*on, "motion", "erase", "5")
+    run(*on, "motion", "push", "knee.yaml", "9")
+    rc, out, err = run(*on, "rom", "restore", "all.bin")
+    check(rc == 0 and "wrote 2 pieces of 128 bytes" in out and "each read back" in out,
+          f"rom restore: only the pieces that differ ({rc}: {out.strip()!r} {err.strip()!r})")
+    check(rom(on, 0x2B80, 53) == knee_at_5 and rom(on, 0x4B80, 1) == b"\xff", "motion 5 back, motion 9 gone")
+    before = glob.glob("rom-before-restore-*.bin")
+    old = open(before[0], "rb").read() if len(before) == 1 else b""
+    check(len(old) == 262144 and old[0x2B80] == 0xFF and old[0x4B80:0x4B88] == knee_at_5[:8]
+          and os.path.exists(before[0] + ".crc32"), f"the ROM it replaced saved first, beside the image ({before})")
+    rc, out, err = run(*on, "rom", "restore", "all.bin")
+    check(rc == 0 and "nothing written" in out, f"restore of the same image writes nothing ({rc}: {out.strip()!r})")
+    damaged = bytearray(image)
+    damaged[100] ^= 0xFF
+    open("damaged.bin", "wb").write(damaged)
+    os.link("all.bin.crc32", "damaged.bin.crc32")
+    rc, out, err = run(*on, "rom", "restore", "damaged.bin")
+    check(rc == 2 and "the file changed or is damaged" in err, f"a damaged image: exit 2 ({rc}: {err.strip()!r})")
+    open("short.bin", "wb").write(image[:1000])
+    rc, out, err = run(*on, "rom", "restore", "short.bin", "--no-check")
+    check(rc == 2 and "a ROM image is 262144" in err, f"an image of the wrong size: exit 2 ({rc}: {err.strip()!r})")
+    os.remove("damaged.bin.crc32")
+    rc, out, err = run(*on, "rom", "restore", "damaged.bin")
+    check(rc == 2 and ".crc32 is missing" in err, f"no .crc32: exit 2 unless --no-check ({rc}: {err.strip()!r})")
+
+# Boards that are not ours.
+board = StandIn()  # acknowledges ROM writes and keeps nothing
+rc, out, err = run("--device", board.path, "motion", "push", "knee10.yaml", "1", "--layout", "2.2", "--backup", "x.bin")
+check(rc == 1 and "ROM 0x000B80 reads back 0xFF, 0x08 was written" in err, f"a board that does not keep ROM writes: exit 1 ({rc}: {err.strip()!r})")
+rc, out, err = run("--device", StandIn(mode="die", die_after=200).path, "rom", "backup", "die.bin")
+check(rc == 4 and "reading ROM stopped at 0x" in err and not os.path.exists("die.bin"), f"a board that dies mid-backup: exit 4, no file ({rc}: {err.strip()!r})")
+rc, out, err = run("--device", StandIn(silent=True).path, "motion", "pull", "1", "s.yaml", "--layout", "2.2")
+check(rc == 4 and not os.path.exists("s.yaml"), f"a silent board: exit 4 ({rc}: {err.strip()!r})")
+rc, out, err = run("--device", StandIn(mode="nack").path, "motion", "erase", "1", "--layout", "2.2")
+check(rc == 1, f"a board that NACKs: exit 1 ({rc}: {err.strip()!r})")
+rc, out, err = run("--device", "/dev/rcb4-no-such-port", "rom", "backup", "n.bin")
+check(rc == 3 and not os.path.exists("n.bin"), f"no such device: exit 3 ({rc}: {err.strip()!r})")
+
+finish()
