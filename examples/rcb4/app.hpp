@@ -224,6 +224,9 @@ struct motion_options {
 void add_layout(CLI::App* cmd, motion_options& o);
 /** The layout --layout names; auto: told from the ROM (ops::detect_layout), else a failure naming why. */
 const rcb4::rom_layout& layout_for(session& s, const motion_options& o);
+/** `motion play FILE`: a motion file played from the host, pose by pose with the board's timing (cmd_motion_files.cpp).
+ */
+int play_file(session& s, const std::string& file, bool rescale, const motion_options& o, const globals& g);
 void add_bench_command(CLI::App& app, context& ctx);   ///< bench (cmd_bench.cpp)
 void add_host_commands(CLI::App& app, context& ctx);   ///< list, doctor (cmd_host.cpp)
 void add_frame_commands(CLI::App& app, context& ctx);  ///< decode, encode (cmd_frames.cpp)

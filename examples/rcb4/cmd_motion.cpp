@@ -8,6 +8,8 @@
 
 #include <unistd.h>
 
+#include <filesystem>
+
 namespace cli {
 
 void add_layout(CLI::App* cmd, motion_options& o) {
@@ -226,25 +228,49 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   auto* motion = app.add_subcommand("motion", "the motions in ROM that the board's program plays (HTH4 projects)");
   motion->require_subcommand(1);
 
-  auto* play_cmd = motion->add_subcommand("play", "play motion N: suspend, reset, CALL, resume (KONDO's four steps)");
+  auto* play_cmd = motion->add_subcommand(
+      "play", "play motion N: suspend, reset, CALL, resume (KONDO's four steps); or a motion FILE from the host");
   struct play_options {
     motion_options m;
-    long long n = 0;
-    bool wait = false, release = false;
+    std::string what;
+    bool wait = false, release = false, rescale = false;
   };
   auto po = std::make_shared<play_options>();
-  play_cmd->add_option("N", po->n, "the motion's number (1..120; 1..50 for --layout 1.3)")->required();
+  play_cmd
+      ->add_option("N|FILE", po->what,
+                   "the motion's number (1..120; 1..50 for --layout 1.3), or a motion file (.yaml) to play from the "
+                   "host, pose by pose with the board's timing, without writing ROM (it always waits)")
+      ->required();
   auto* wait_flag = play_cmd->add_flag("--wait", po->wait, "wait until it ends, with a progress line on a terminal");
   add_timeout(play_cmd, po->m, " with --wait")->needs(wait_flag);
   add_layout(play_cmd, po->m);
   play_cmd->add_flag("--release", po->release,
                      "turn the servo outputs off while the program is suspended (KONDO's libraries do; "
                      "by default they keep holding, so the robot does not go limp between motions)");
+  play_cmd->add_flag("--rescale", po->rescale,
+                     "FILE made for another output period: keep its times in ms (frames of the board's period)");
   play_cmd->callback([&ctx, po] {
-    if (po->n < 1 || po->n > 120) throw usage_error(fmt::format("motion number: {} is outside 1..120", po->n));
-    ctx.action = [&ctx, po] {
+    const bool number = !po->what.empty() && std::all_of(po->what.begin(), po->what.end(), [](char c) {
+      return std::isdigit(static_cast<unsigned char>(c));
+    });
+    if (!number) {
+      const auto ext = std::filesystem::path(po->what).extension();
+      if (ext != ".yaml" && ext != ".yml")
+        throw usage_error(
+            fmt::format("N|FILE: '{}' is neither a motion number nor a motion file (.yaml, .yml)", po->what));
+      if (po->release) throw usage_error("--release is for ROM motions: a file played from the host keeps the servos");
+      ctx.action = [&ctx, po] {
+        session s(ctx.g);
+        return play_file(s, po->what, po->rescale, po->m, ctx.g);
+      };
+      return;
+    }
+    if (po->rescale) throw usage_error("--rescale is for a motion file; motion N plays the ROM's frames as they are");
+    const long long n = po->what.size() > 4 ? 0 : std::stoll(po->what);
+    if (n < 1 || n > 120) throw usage_error(fmt::format("motion number: {} is outside 1..120", po->what));
+    ctx.action = [&ctx, po, n] {
       session s(ctx.g);
-      return play(s, static_cast<unsigned>(po->n), po->release, po->wait, po->m, ctx.g);
+      return play(s, static_cast<unsigned>(n), po->release, po->wait, po->m, ctx.g);
     };
   });
 

@@ -4,6 +4,7 @@
 #include "app.hpp"
 
 #include <rcb4/motion/disassemble.hpp>
+#include <rcb4/motion/player.hpp>
 #include <rcb4/robot/motion_file.hpp>
 
 #include <fmt/format.h>
@@ -11,6 +12,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 namespace cli {
 namespace {
@@ -304,7 +306,122 @@ int erase(session& s, const push_options& o, const globals& g) {
   return exit_ok;
 }
 
+/** Waits until @p t, waking every 50 ms for Ctrl-C; false when a signal came. */
+bool wait_until(std::chrono::steady_clock::time_point t) {
+  while (!signal_catcher::caught()) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= t) return true;
+    std::this_thread::sleep_until(std::min(t, now + std::chrono::milliseconds(50)));
+  }
+  return false;
+}
+
 }  // namespace
+
+int play_file(session& s, const std::string& file, bool rescale, const motion_options& o, const globals& g) {
+  const auto& robot = robot_of(g);
+  ro::motion_document d;
+  try {
+    d = ro::load_motion(file, robot);
+  } catch (const ro::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  // The layout matters only to a call of another motion by number.
+  const bool calls = std::any_of(d.steps.begin(), d.steps.end(),
+                                 [](const auto& st) { return std::holds_alternative<ro::motion_call>(st); });
+  const auto& layout = calls ? layout_for(s, o) : rcb4::hth4_2_2;
+  const auto period = board_period(s);
+  const auto c = ro::to_program(d, robot, layout, period, rescale);
+  if (!ro::ok(c)) throw usage_error(fmt::format("{}: {} (nothing was sent)", file, std::get<ro::problem>(c).message));
+  const auto& cm = std::get<ro::compiled_motion>(c);
+  if (!g.json)
+    for (const auto& note : cm.notes) fmt::print(stderr, "note: {}\n", note);
+  if (const auto st = s.run(rcb4::ops::read_motion_state(layout)); st.running)
+    throw failure(exit_board,
+                  fmt::format("{} is running on the board: it would fight the poses, so nothing was sent",
+                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program")),
+                  "rcb4 motion wait, or rcb4 motion stop");
+  // Every servo a pose moves needs a slot: the board ignores one it has none for.
+  const auto table = s.run(rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
+  const auto slots = rcb4::ops::parse_allocation_table(table);
+  if (!slots) throw rcb4::transport::system_error(slots.error());
+  for (const auto& st : cm.program.steps)
+    if (const auto* p = std::get_if<mo::pose>(&st))
+      for (const auto& e : p->targets)
+        if (std::none_of(slots->begin(), slots->end(), [&](const auto& k) { return k.ics == e.ics; })) {
+          const auto* j = robot.on(e.ics);
+          throw failure(exit_board,
+                        fmt::format("{} (ICS {}) has no slot on the board: its poses would not move it, so nothing "
+                                    "was sent",
+                                    j ? j->name : "a servo", e.ics.value()),
+                        "rcb4 scan shows the board's slots");
+        }
+  mo::player pl(cm.program);
+  if (!pl.error().empty()) throw usage_error(fmt::format("{}: {}", file, pl.error()));
+  const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period));
+  const bool tty = ::isatty(STDERR_FILENO) && !g.json;
+  signal_catcher catcher;
+  const auto start = std::chrono::steady_clock::now();
+  auto ready = start;  // when the board has finished the last pose: the next step comes then
+  const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+  bool stopped = false;
+  for (auto a = pl.next(); !std::holds_alternative<mo::finished>(a); a = pl.next()) {
+    if (!wait_until(ready)) {
+      stopped = true;
+      break;
+    }
+    if (const auto* snd = std::get_if<mo::send>(&a)) {
+      s.run(rcb4::ops::detail::ack_sequence({snd->cmd}));
+      ready = std::max(ready, std::chrono::steady_clock::now()) + snd->frames * frame;
+      if (tty) fmt::print(stderr, "\r  step {}  pose {}  {:5.1f} s ", pl.step(), pl.poses(), seconds());
+    } else if (const auto* r = std::get_if<mo::read_value>(&a)) {
+      const auto v = s.run(rcb4::ops::read_memory(memory::ram, r->address.value(), r->size));
+      pl.value(static_cast<std::uint16_t>(v[0] | (r->size > 1 ? v[1] << 8 : 0)));
+    } else if (const auto* k = std::get_if<mo::play_code>(&a)) {
+      const std::uint32_t at = k->address.value(), base = layout.motion_base.value();
+      const auto n =
+          at >= base && (at - base) % layout.slot_size == 0 && (at - base) / layout.slot_size < layout.motion_count
+              ? std::optional<unsigned>((at - base) / layout.slot_size + 1)
+              : std::nullopt;
+      if (!n)
+        throw failure(exit_usage,
+                      fmt::format("{}: step {} calls 0x{:06X}, which starts no motion slot ({} layout): from the host "
+                                  "only whole motions are played",
+                                  file, pl.step(), k->address.value(), layout.name));
+      s.run(rcb4::ops::play_motion(*n, layout));
+      rcb4::transport::error_code ec;
+      rcb4::transport::wait_motion(s.c(), std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)), ec, {},
+                                   layout);
+      if (ec) throw rcb4::transport::system_error(ec);
+      ready = std::chrono::steady_clock::now();
+    }
+  }
+  if (!stopped) stopped = !wait_until(ready);
+  if (tty) fmt::print(stderr, "\r{:60}\r", "");
+  if (!pl.error().empty() && !stopped)
+    throw failure(exit_usage, fmt::format("{}: stopped at step {}: {}", file, pl.step(), pl.error()));
+  if (stopped) {
+    if (g.json)
+      emit(json{{"played", file}, {"interrupted", true}, {"poses", pl.poses()}, {"seconds", seconds()}});
+    else
+      fmt::print(stderr, "interrupted at step {} after {} ({:.1f} s): the servos stay where the last pose took them\n",
+                 pl.step(), plural(pl.poses(), "pose"), seconds());
+    return exit_interrupted;
+  }
+  if (g.json)
+    emit(json{{"played", file},
+              {"interrupted", false},
+              {"poses", pl.poses()},
+              {"calls", pl.calls()},
+              {"seconds", std::round(seconds() * 100) / 100},
+              {"period_ms", rcb4::milliseconds(period)},
+              {"notes", cm.notes}});
+  else
+    fmt::print("played {} from the host: {}{} in {:.2f} s ({} ms frames; nothing written to ROM)\n", file,
+               plural(pl.poses(), "pose"), pl.calls() ? ", " + plural(pl.calls(), "ROM motion") : "", seconds(),
+               rcb4::milliseconds(period));
+  return exit_ok;
+}
 
 void add_motion_file_commands(CLI::App* motion, context& ctx) {
   auto pl = std::make_shared<pull_options>();

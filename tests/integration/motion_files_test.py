@@ -9,8 +9,11 @@
 import glob
 import json
 import os
+import signal
+import subprocess
 import sys
 import tempfile
+import time
 import zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -138,6 +141,37 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(rc == 0 and rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, f"the backup put back ({rc}: {out.strip()!r} {err.strip()!r})")
     rc, out, err = run(*on, "motion", "erase", "9")
     check(rc == 0 and "already empty" in out, f"erase of an empty slot writes nothing ({rc}: {out.strip()!r})")
+
+    # Played from the host, nothing written: 3 poses of 300 ms, the knee at +30 at the end.
+    run(*on, "joint", "move", "left_knee=0@15")
+    before_rom = rom(on, 0x0B80, 2048 * 10)
+    rc, out, err = run("--json", *on, "motion", "play", "knee.yaml")
+    j = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and j.get("poses") == 3 and j.get("calls") == 0 and 0.85 <= j.get("seconds", 0) < 2.5,
+          f"motion play knee.yaml: 3 poses in about 0.9 s ({rc}: {out.strip()!r} {err.strip()!r})")
+    rc, out, err = run("--json", *on, "joint", "list")
+    knee = [x for x in json.loads(out) if x["name"] == "left_knee"][0] if rc == 0 else {}
+    check(abs(knee.get("degrees", 99) - 30) < 0.1 and rom(on, 0x0B80, 2048 * 10) == before_rom,
+          f"the knee at +30 deg, the ROM untouched ({knee.get('degrees')})")
+    write("calls.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {head_yaw: 20}\n    time_ms: 150\n"
+                        "  - call: 1\n  - end\n")
+    rc, out, err = run(*on, "motion", "play", "calls.yaml")
+    check(rc == 0 and "1 pose, 1 ROM motion in" in out, f"a file that calls ROM motion 1 ({rc}: {out.strip()!r} {err.strip()!r})")
+    write("unslotted.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {\"ics 30\": 7500}\n    time_ms: 150\n  - end\n")
+    rc, out, err = run(*on, "motion", "play", "unslotted.yaml")
+    check(rc == 1 and "(ICS 30) has no slot on the board" in err, f"a servo without a slot: exit 1, nothing sent ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "play", "knee10.yaml")
+    check(rc == 2 and "--rescale" in err, f"play of a file for another period: exit 2 ({rc}: {err.strip()!r})")
+    # A motion that never ends, stopped with Ctrl-C.
+    write("forever.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - label: a\n  - pose: {left_knee: 10}\n    time_ms: 150\n"
+                          "  - pose: {left_knee: -10}\n    time_ms: 150\n  - goto: a\n")
+    proc = subprocess.Popen([RCB4, *on, "motion", "play", "forever.yaml"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    check(proc.returncode == 130 and "interrupted at step" in err and time.monotonic() - sent < 1.0,
+          f"Ctrl-C stops a motion played from the host within 1 s ({proc.returncode}: {err.strip()!r})")
 
     # Mistakes in files: named with file and line, exit 2.
     write("bad.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {left_kneee: 3}\n    time_ms: 10\n")
