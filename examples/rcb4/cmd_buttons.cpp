@@ -268,6 +268,27 @@ void add_button_commands(CLI::App* motion, context& ctx) {
   on_device(press, ctx, [&ctx, o, po](session& s) {
     const auto word = buttons_of(po->buttons);
     const auto& layout = layout_for(s, *o);
+    // What the board would do, from the table it compares (RAM): nothing, or a call of an empty
+    // slot (which stops its program), is said before anything is pressed.
+    const auto t = read_tables(s);
+    const rcb4::vector_entry* entry = nullptr;
+    for (const auto& e : t.ram.entries)
+      if (e.buttons() == word) {
+        entry = &e;
+        break;
+      }
+    if (!entry && std::none_of(t.ram.entries.begin(), t.ram.entries.end(), [](const auto& e) { return !e.buttons(); }))
+      throw failure(exit_board, fmt::format("no entry of the table plays anything for {}", mo::buttons_text(word)),
+                    "rcb4 motion buttons shows the table; rcb4 motion buttons set BUTTONS N adds one");
+    if (entry) {
+      const auto first = s.run(rcb4::ops::read_memory(memory::rom, entry->target.value(), 128));
+      if (!rcb4::ops::detail::holds_frame(first))
+        throw failure(exit_board,
+                      fmt::format("{} plays {}, which holds no motion: a press would stop the board's program",
+                                  mo::buttons_text(word), target_text(entry->target.value(), layout, robot_of(ctx.g))),
+                      fmt::format("rcb4 motion buttons clear {}, or rcb4 motion push FILE N into that slot",
+                                  mo::buttons_text(word)));
+    }
     const auto bytes = rcb4::krr::encode_buttons(word);
     s.run(rcb4::ops::write_memory(memory::ram, rcb4::krr::buttons.value(), bytes));
     // The board compares the table once per output period (10-25 ms): a motion runs within a few.

@@ -87,6 +87,14 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const rcb4::rom_layo
                   "wait longer (--timeout S), or stop it: rcb4 motion stop");
   if (ec) throw rcb4::transport::system_error(ec);
   // Not running because the ROM program is off with a CALL pending: it did not end, it stopped.
+  if (st.suspended && s.run(rcb4::ops::read_config{}).program_error)
+    throw failure(exit_board,
+                  fmt::format("{} stopped after {:.1f} s on an error of the board's program at 0x{:06X} "
+                              "(program-error: no frame there, such as an erased motion)",
+                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program"), seconds(),
+                              st.program_counter),
+                  "rcb4 motion show / motion list show what is there; motion resume would stop again: rcb4 motion "
+                  "play N (or a power cycle) starts the program afresh");
   if (st.suspended)
     throw failure(exit_board,
                   fmt::format("{} stopped part way after {:.1f} s: the ROM program is off (program counter 0x{:06X})",
@@ -286,6 +294,11 @@ void add_motion_commands(CLI::App& app, context& ctx) {
 
   auto* resume = motion->add_subcommand("resume", "let the ROM program run again");
   on_device(resume, ctx, [&ctx](session& s) {
+    if (s.run(rcb4::ops::read_config{}).program_error)
+      throw failure(exit_board,
+                    "the board's program stopped on an error (program-error: no frame where it was, such as an erased "
+                    "motion): resuming would stop it again at once",
+                    "rcb4 motion status shows where; rcb4 motion play N starts the program afresh");
     s.run(rcb4::ops::resume_motion());
     if (ctx.g.json)
       emit(json{{"resumed", true}});
@@ -299,10 +312,19 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   add_layout(status, *so);
   on_device(status, ctx, [&ctx, so](session& s) {
     const auto st = s.run(rcb4::ops::read_motion_state(layout_for(s, *so)));
-    if (ctx.g.json)
-      emit(state_json(st));
-    else
+    const bool error = st.suspended && s.run(rcb4::ops::read_config{}).program_error;
+    if (ctx.g.json) {
+      auto j = state_json(st);
+      j["program_error"] = error;
+      emit(j);
+    } else if (error) {
+      fmt::print(
+          "{} stopped on an error of the board's program at 0x{:06X} (program-error: no frame there, such as an "
+          "erased motion); motion resume would stop again: rcb4 motion play N starts afresh\n",
+          st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program"), st.program_counter);
+    } else {
       fmt::print("{}\n", state_text(st));
+    }
     return exit_ok;
   });
 

@@ -83,7 +83,10 @@ std::string now_stamp() {
 
 /** Saves @p bytes (a slot's old contents) to @p path, or to motion-N-DATE.bin when it is empty. */
 std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, unsigned n) {
-  if (path.empty()) path = fmt::format("motion-{}-{}.bin", n, now_stamp());
+  if (path.empty()) {
+    path = fmt::format("motion-{}-{}.bin", n, now_stamp());
+    for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", n, now_stamp(), k);
+  }
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   out.flush();
@@ -97,11 +100,11 @@ std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, uns
 
 /** Refuses to write while the ROM program runs a motion (the board would fetch the bytes being replaced). */
 void require_idle(session& s, const rcb4::rom_layout& layout) {
+  // A motion slot's code running (servos still moving after a host move set the update flags too: that is no program).
   const auto st = s.run(rcb4::ops::read_motion_state(layout));
-  if (st.running)
+  if (st.running && st.motion)
     throw failure(exit_board,
-                  fmt::format("{} is running: the board would run the bytes being written",
-                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program")),
+                  fmt::format("motion {} is running: the board would run the bytes being written", *st.motion),
                   "rcb4 motion wait, or rcb4 motion stop, then write");
 }
 
@@ -109,6 +112,27 @@ void require_idle(session& s, const rcb4::rom_layout& layout) {
 void warn_buttons(session& s, const mo::slot& where, unsigned n, std::string_view what, const globals& g) {
   const auto b = entries_playing(s, where.address.value());
   if (!b.empty() && !g.json) fmt::print(stderr, "note: {} plays motion {}: {}\n", fmt::join(b, ", "), n, what);
+}
+
+/** Refuses a program that calls an empty slot: the board's program would stop there (program-error). */
+void check_callees(session& s, const mo::program& p, const mo::slot& where) {
+  for (std::size_t i = 0; i < p.steps.size(); ++i)
+    if (const auto* c = std::get_if<mo::call_motion>(&p.steps[i]); c && c->address != where.address) {
+      const auto first = s.run(rcb4::ops::read_memory(memory::rom, c->address.value(), 128));
+      if (!rcb4::ops::detail::holds_frame(first))
+        throw failure(exit_board,
+                      fmt::format("step {} calls 0x{:06X}, which holds no motion: the board's program would stop "
+                                  "there (nothing was written)",
+                                  i + 1, c->address.value()),
+                      "push that motion first; rcb4 motion list shows the used slots");
+    }
+}
+
+/** The --layout value that names @p layout, for hints a user can paste. */
+std::string_view layout_flag(const rcb4::rom_layout& layout) {
+  if (&layout == &rcb4::hth4_1_3) return "1.3";
+  if (&layout == &rcb4::hth4_2_0) return "2.0";
+  return "2.2";
 }
 
 struct pull_options {
@@ -214,6 +238,7 @@ std::vector<std::uint8_t> bytes_of(session& s, const push_options& o, const rcb4
   if (!ro::ok(c))
     throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<ro::problem>(c).message));
   const auto& cm = std::get<ro::compiled_motion>(c);
+  check_callees(s, cm.program, where);
   notes = cm.notes;
   const auto b = mo::assemble(cm.program, where);
   if (!mo::ok(b))
@@ -296,13 +321,18 @@ int erase(session& s, const push_options& o, const globals& g) {
   const std::vector<std::uint8_t> erased(where.size, 0xFF);
   write_rom_checked(s, where.address.value(), erased, fmt::format("erasing motion {}", n), g);
   warn_buttons(s, where, n, "a press now stops the board's program (rcb4 motion buttons clear)", g);
+  // Motion 1 is where the layout is told from: without it, --layout must say it.
+  const std::string again = n == 1 && o.m.layout == "auto" ? fmt::format(" --layout {}", layout_flag(layout)) : "";
+  if (!again.empty() && !g.json)
+    fmt::print(stderr, "note: motion 1 told the board's layout ({}); from now on give it: --layout {}\n", layout.name,
+               layout_flag(layout));
   if (g.json)
     emit(json{{"erased", n}, {"address", where.address.value()}, {"unchanged", false}, {"backup", saved}});
   else
     fmt::print(
         "erased motion {} (0x{:06X}, {} bytes of 0xFF, read back); the old bytes are in {} "
-        "(rcb4 motion push {} {} puts them back)\n",
-        n, where.address.value(), where.size, saved, saved, n);
+        "(rcb4 motion push {} {}{} puts them back)\n",
+        n, where.address.value(), where.size, saved, saved, n, again);
   return exit_ok;
 }
 
@@ -336,11 +366,11 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
   const auto& cm = std::get<ro::compiled_motion>(c);
   if (!g.json)
     for (const auto& note : cm.notes) fmt::print(stderr, "note: {}\n", note);
-  if (const auto st = s.run(rcb4::ops::read_motion_state(layout)); st.running)
-    throw failure(exit_board,
-                  fmt::format("{} is running on the board: it would fight the poses, so nothing was sent",
-                              st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program")),
-                  "rcb4 motion wait, or rcb4 motion stop");
+  if (const auto st = s.run(rcb4::ops::read_motion_state(layout)); st.running && st.motion)
+    throw failure(
+        exit_board,
+        fmt::format("motion {} is running on the board: it would fight the poses, so nothing was sent", *st.motion),
+        "rcb4 motion wait, or rcb4 motion stop");
   // Every servo a pose moves needs a slot: the board ignores one it has none for.
   const auto table = s.run(rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
   const auto slots = rcb4::ops::parse_allocation_table(table);
@@ -356,6 +386,7 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
                                     j ? j->name : "a servo", e.ics.value()),
                         "rcb4 scan shows the board's slots");
         }
+  check_callees(s, cm.program, mo::slot{rcb4::rom_address{}, 0});
   mo::player pl(cm.program);
   if (!pl.error().empty()) throw usage_error(fmt::format("{}: {}", file, pl.error()));
   const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period));
@@ -424,6 +455,15 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
 }
 
 void add_motion_file_commands(CLI::App* motion, context& ctx) {
+  // A backup is what `motion push FILE.bin N` puts back, and never replaces a file.
+  const CLI::Validator backup_name(
+      [](std::string& v) -> std::string {
+        if (std::filesystem::path(v).extension() != ".bin")
+          return fmt::format("{} does not end in .bin (motion push puts a .bin back)", v);
+        if (std::filesystem::exists(v)) return fmt::format("{} exists: a backup never replaces a file", v);
+        return {};
+      },
+      "FILE.bin");
   auto pl = std::make_shared<pull_options>();
   auto* pull_cmd = motion->add_subcommand(
       "pull", "motion N to a motion file (YAML: the profile's joints in degrees, times in ms; see the README)");
@@ -446,7 +486,10 @@ void add_motion_file_commands(CLI::App* motion, context& ctx) {
       "push", "write a motion file (or a .bin backup) into motion N: checked, the old bytes backed up, read back");
   push_cmd->add_option("FILE", pu->file, "a motion file (.yaml/.yml), or a backup (.bin) to put back")->required();
   push_cmd->add_option("N", pu->n, "the motion's number")->required()->check(int_range(1, 120));
-  push_cmd->add_option("--backup", pu->backup, "where the slot's old bytes go (default: motion-N-DATE.bin here)");
+  push_cmd
+      ->add_option("--backup", pu->backup,
+                   "where the slot's old bytes go: a new .bin file (default: motion-N-DATE.bin here)")
+      ->check(backup_name);
   push_cmd->add_flag("--rescale", pu->rescale,
                      "a file made for another output period: keep its times in ms (frames of the board's period)");
   push_cmd->add_flag("--dry-run", pu->dry_run, "check and assemble, print the bytes, write nothing");
@@ -457,7 +500,10 @@ void add_motion_file_commands(CLI::App* motion, context& ctx) {
   auto* erase_cmd =
       motion->add_subcommand("erase", "empty motion N (0xFF, as erased ROM reads), the old bytes backed up first");
   erase_cmd->add_option("N", er->n, "the motion's number")->required()->check(int_range(1, 120));
-  erase_cmd->add_option("--backup", er->backup, "where the slot's old bytes go (default: motion-N-DATE.bin here)");
+  erase_cmd
+      ->add_option("--backup", er->backup,
+                   "where the slot's old bytes go: a new .bin file (default: motion-N-DATE.bin here)")
+      ->check(backup_name);
   add_layout(erase_cmd, er->m);
   on_device(erase_cmd, ctx, [&ctx, er](session& s) { return erase(s, *er, ctx.g); });
 }

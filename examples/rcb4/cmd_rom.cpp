@@ -96,16 +96,21 @@ std::vector<std::uint8_t> load(const std::string& path, bool no_check) {
   }
   const auto want = fmt::format("{:08x}", crc32(image));
   if (word != want)
-    throw usage_error(
-        fmt::format("FILE: {} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word));
+    throw failure(
+        exit_usage,
+        fmt::format("FILE: {} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
+        fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
+                    "delete {}.crc32 and restore with --no-check",
+                    path, path));
   return image;
 }
 
 int restore(session& s, const std::string& path, bool no_check, const globals& g) {
   const auto image = load(path, no_check);
-  const auto cfg = s.run(rcb4::ops::read_config{});
-  // The ROM program fetches from ROM: stop it before its bytes change under it.
-  if (cfg.rom_program) s.run(rcb4::ops::stop_motion{});
+  // A motion part way would be cut off, and its code may change under it.
+  if (const auto st = s.run(rcb4::ops::read_motion_state{}); st.running && st.motion)
+    throw failure(exit_board, fmt::format("motion {} is running: the restore would rewrite what it runs", *st.motion),
+                  "rcb4 motion wait, or rcb4 motion stop, then restore");
   const auto version = s.run(rcb4::ops::read_version{});
   const auto now = read_all(s, "reading ROM (the backup of what is replaced)", g);
   std::vector<std::size_t> differ;
@@ -118,10 +123,12 @@ int restore(session& s, const std::string& path, bool no_check, const globals& g
     if (g.json)
       emit(json{{"restored", path}, {"pieces_written", 0}, {"unchanged", true}});
     else
-      fmt::print("the board's ROM already is {}: nothing written{}\n", path,
-                 cfg.rom_program ? " (the ROM program was stopped: rcb4 motion resume runs it again)" : "");
+      fmt::print("the board's ROM already is {}: nothing written\n", path);
     return exit_ok;
   }
+  // The ROM program fetches from ROM: stop it before its bytes change under it.
+  const auto cfg = s.run(rcb4::ops::read_config{});
+  if (cfg.rom_program) s.run(rcb4::ops::stop_motion{});
   // Beside the image being restored: where the user keeps ROM images.
   const std::string before =
       (std::filesystem::path(path).parent_path() / fmt::format("rom-before-restore-{}.bin", stamp())).string();

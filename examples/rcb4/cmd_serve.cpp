@@ -97,15 +97,37 @@ int serve(serve_options& o, const globals& g) {
     fmt::print("{}\n", server->where());
   std::fflush(stdout);
 
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  signals.async_wait([&](const boost::system::error_code&, int) { server->stop(); });
-  io.run();
-
-  if (!o.rom_path.empty()) {
-    std::ofstream f(o.rom_path, std::ios::binary | std::ios::trunc);
+  // The ROM is saved whenever it changed (checked every second, on the board's own thread), and at
+  // the end: a closed terminal (SIGHUP) or a kill loses at most the last second.
+  std::vector<std::uint8_t> saved(board.rom().begin(), board.rom().end());
+  const auto save = [&] {
+    if (o.rom_path.empty() || std::equal(saved.begin(), saved.end(), board.rom().begin(), board.rom().end())) return;
+    const std::string tmp = o.rom_path + ".tmp";
+    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
     f.write(reinterpret_cast<const char*>(board.rom().data()), static_cast<std::streamsize>(board.rom().size()));
-    if (!f) throw failure(exit_io, fmt::format("could not save the ROM to {}", o.rom_path));
-  }
+    f.close();
+    std::error_code ec;
+    if (!f || (std::filesystem::rename(tmp, o.rom_path, ec), ec))
+      throw failure(exit_io, fmt::format("could not save the ROM to {}", o.rom_path));
+    saved.assign(board.rom().begin(), board.rom().end());
+  };
+  boost::asio::steady_timer saver(io);
+  std::function<void()> arm = [&] {
+    saver.expires_after(std::chrono::seconds(1));
+    saver.async_wait([&](const boost::system::error_code& ec) {
+      if (ec) return;
+      save();
+      arm();
+    });
+  };
+  if (!o.rom_path.empty()) arm();
+  boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
+  signals.async_wait([&](const boost::system::error_code&, int) {
+    saver.cancel();
+    server->stop();
+  });
+  io.run();
+  save();
   return exit_ok;
 }
 
@@ -122,7 +144,9 @@ void add_serve_command(CLI::App& app, context& ctx) {
   cmd->add_option("--latency", o->latency_us, "extra microseconds before each reply (USB adapter, turnaround)")
       ->type_name("US")
       ->check(int_range(0, 10'000'000));
-  cmd->add_option("--rom", o->rom_path, "load the 256 KiB ROM image from FILE if it exists; save it there on exit")
+  cmd->add_option(
+         "--rom", o->rom_path,
+         "load the 256 KiB ROM image from FILE if it exists; save it there when it changes (each second) and on exit")
       ->type_name("FILE");
   cmd->add_option("--series", o->series, "SERIES (0x11): reboot (default, as measured in 2015) or execute")
       ->check(CLI::IsMember({"reboot", "execute"}));

@@ -426,6 +426,10 @@ outcome<compiled_motion> to_program(const motion_document& d, const model& m, co
     return "step " + std::to_string(i + 1) +
            (i < d.where.size() && !d.where[i].empty() ? " (" + d.where[i] + ")" : "") + ": ";
   };
+  if (d.steps.empty()) return problem{"the motion has no steps"};
+  if (!std::holds_alternative<motion::end>(d.steps.back()) && !std::holds_alternative<motion::go_to>(d.steps.back()))
+    return problem{at(d.steps.size() - 1) +
+                   "the last step is neither end nor goto: the board would run on into the bytes after the motion"};
   std::set<std::string> labels;
   for (std::size_t i = 0; i < d.steps.size(); ++i)
     if (const auto* l = std::get_if<motion::label>(&d.steps[i]))

@@ -137,8 +137,31 @@ with serve("--rom", rom_file, "--period", "15") as dev:
           f"motion erase 5 ({rc}: {out.strip()!r} {err.strip()!r})")
     rc, out, err = run(*on, "motion", "list")
     check(rc == 0 and "0x02B80" not in out, "motion list no longer shows 5")
+    rc, out, err = run(*on, "motion", "buttons", "press", "left")
+    check(rc == 1 and "holds no motion: a press would stop the board's program" in err,
+          f"press of a button on an erased slot: refused ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "push", "five.bin", "5")
     check(rc == 0 and rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, f"the backup put back ({rc}: {out.strip()!r} {err.strip()!r})")
+    run(*on, "motion", "buttons", "clear", "left")
+    rc, out, err = run(*on, "motion", "erase", "5", "--backup", "five.bin")
+    check(rc == 2 and "a backup never replaces a file" in err, f"--backup over an existing file: exit 2 ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "erase", "5", "--backup", "five.yaml")
+    check(rc == 2 and ".bin" in err, f"--backup not .bin: exit 2 ({rc}: {err.strip()!r})")
+    write("calls9.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - call: 9\n  - end\n")
+    rc, out, err = run(*on, "motion", "push", "calls9.yaml", "6")
+    check(rc == 1 and "step 1 calls 0x004B80, which holds no motion" in err, f"push of a call of an empty slot: exit 1 ({rc}: {err.strip()!r})")
+    # A ROM motion that calls an empty slot (written raw): the board's program stops on an error.
+    run(*on, "write", "rom", "0x3B80", "07 0C 80 4B 00 00 DE 03 0D 10")
+    rc, out, err = run(*on, "motion", "play", "7", "--wait", "--timeout", "5")
+    check(rc == 1 and "on an error of the board's program" in err and "motion play N" in err,
+          f"a call of an erased slot stops the program: exit 1, saying so ({rc}: {err.strip()!r})")
+    rc, out, err = run("--json", *on, "motion", "status")
+    check(rc == 0 and json.loads(out).get("program_error") is True, f"status says program_error ({out.strip()!r})")
+    rc, out, err = run(*on, "motion", "resume")
+    check(rc == 1 and "resuming would stop it again" in err, f"resume after a program error: refused ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "play", "1", "--wait", "--timeout", "5")
+    check(rc == 0, f"motion play 1 starts the program afresh ({rc}: {err.strip()!r})")
+    run(*on, "write", "rom", "0x3B80", "FF FF FF FF FF FF FF FF FF FF")
     rc, out, err = run(*on, "motion", "erase", "9")
     check(rc == 0 and "already empty" in out, f"erase of an empty slot writes nothing ({rc}: {out.strip()!r})")
 
@@ -172,6 +195,13 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     out, err = proc.communicate(timeout=10)
     check(proc.returncode == 130 and "interrupted at step" in err and time.monotonic() - sent < 1.0,
           f"Ctrl-C stops a motion played from the host within 1 s ({proc.returncode}: {err.strip()!r})")
+
+    # Motion 1 tells the layout: erased, the hint to put it back names --layout.
+    rc, out, err = run(*on, "motion", "erase", "1", "--backup", "one.bin")
+    check(rc == 0 and "from now on give it: --layout 2.2" in err and "rcb4 motion push one.bin 1 --layout 2.2" in out,
+          f"erase 1 says the layout must be given ({rc}: {out.strip()!r} {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "one.bin", "1", "--layout", "2.2")
+    check(rc == 0, f"the hint's command puts motion 1 back ({rc}: {err.strip()!r})")
 
     # Mistakes in files: named with file and line, exit 2.
     write("bad.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {left_kneee: 3}\n    time_ms: 10\n")
@@ -212,6 +242,24 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     os.remove("damaged.bin.crc32")
     rc, out, err = run(*on, "rom", "restore", "damaged.bin")
     check(rc == 2 and ".crc32 is missing" in err, f"no .crc32: exit 2 unless --no-check ({rc}: {err.strip()!r})")
+
+# The served ROM is saved when it changes, not only at a clean exit.
+rom2 = os.path.join(work, "hup.rom")
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--rom", rom2, "--period", "15"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+rc, out, err = run("--device", dev, "motion", "push", "knee.yaml", "5", "--backup", "hup5.bin")
+time.sleep(1.6)
+srv.kill()  # SIGKILL: no chance to save at exit
+srv.wait(timeout=10)
+image = open(rom2, "rb").read() if os.path.exists(rom2) else b""
+check(rc == 0 and image[0x2B80:0x2B80 + 53] == knee_at_5, f"serve --rom saved the change within a second, before a kill ({rc})")
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--rom", rom2], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+run("--device", dev, "motion", "erase", "5", "--backup", "hup5b.bin")
+srv.send_signal(signal.SIGHUP)  # a closed terminal
+srv.wait(timeout=10)
+image = open(rom2, "rb").read()
+check(srv.returncode == 0 and image[0x2B80:0x2B88] == b"\xff" * 8, f"SIGHUP saves the ROM too ({srv.returncode})")
 
 # Boards that are not ours.
 board = StandIn()  # acknowledges ROM writes and keeps nothing

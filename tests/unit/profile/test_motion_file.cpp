@@ -235,6 +235,9 @@ TEST_CASE("motion file: mistakes name the file, the line and what is wrong", "[m
         std::string::npos);
   CHECK(parse_error(with_steps("  - pose: missing.yaml\n    time_ms: 10\n")).find("missing.yaml") == 0);
   CHECK(program_problem(with_steps("  - goto: nowhere\n")) == "step 1 (m.yaml:4): no label is called 'nowhere'");
+  CHECK(program_problem(with_steps("  - pose: {left_knee: 3}\n    time_ms: 10\n")) ==
+        "step 1 (m.yaml:4): the last step is neither end nor goto: the board would run on into the bytes after the "
+        "motion");
   CHECK(program_problem(with_steps("  - label: a\n  - label: a\n  - end\n")).find("'a' is defined twice") !=
         std::string::npos);
   CHECK(program_problem(with_steps("  - pose: {left_knee: 3, \"ics 16\": 7500}\n    time_ms: 10\n  - end\n"))
