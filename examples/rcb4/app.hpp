@@ -234,6 +234,17 @@ void add_serve_command(CLI::App& app, context& ctx);   ///< serve (cmd_serve.cpp
 void add_robot_commands(CLI::App& app, context& ctx);  ///< joint, pose, trim, scan (cmd_robot.cpp)
 void add_ui_command(CLI::App& app, context& ctx);      ///< ui (cmd_ui.cpp, ui/)
 void add_rom_commands(CLI::App& app, context& ctx);    ///< rom backup|restore (cmd_rom.cpp)
+// Shared by the robot commands (cmd_robot.cpp) and motion record (cmd_record.cpp).
+/** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
+bool wait_for_enter();
+/** The joints the words name (joints, groups, "all"; none: all), each once, in the model's order. */
+std::vector<const rcb4::robot::joint*> joints_of(const rcb4::robot::model& m, const std::vector<std::string>& words);
+/** Where the joints are on this board; joints without a block are an error naming them. */
+rcb4::robot::joint_map locate(session& s, const rcb4::robot::model& m,
+                              const std::vector<const rcb4::robot::joint*>& need);
+/** Every located joint's block fields @p f, in the reads the planner chooses for this link. */
+std::vector<rcb4::robot::joint_reading> read_all(session& s, const rcb4::robot::joint_map& map, rcb4::robot::fields f);
+void add_record_command(CLI::App* motion, context& ctx);  ///< motion record (cmd_record.cpp)
 
 /** An exception's words for a person: without Boost's " [category:value]" tail or the library's "rcb4: " prefix. */
 std::string_view plain_message(std::string_view what);

@@ -12,17 +12,6 @@
 #include <unistd.h>
 
 namespace cli {
-namespace {
-
-using namespace std::chrono_literals;
-namespace robot = rcb4::robot;
-
-/** Degrees to a hundredth for JSON, without -0; null for none. */
-json rounded(std::optional<double> d) {
-  if (!d) return nullptr;
-  const double r = std::round(*d * 100) / 100;
-  return r == 0 ? 0.0 : r;
-}
 
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
 bool wait_for_enter() {
@@ -35,34 +24,28 @@ bool wait_for_enter() {
   return false;
 }
 
-/** Degrees to a tenth, signed, without "-0.0"; "-" for none. */
-std::string deg_text(std::optional<double> d) {
-  if (!d) return "-";
-  const double tenths = std::round(*d * 10) / 10;
-  return fmt::format("{:+.1f}", tenths == 0 ? 0.0 : tenths);
-}
-
 /** The joints the words name (joints, groups, "all"; none: all), each once, in the model's order. */
-std::vector<const robot::joint*> joints_of(const robot::model& m, const std::vector<std::string>& words) {
-  if (words.empty()) return std::get<std::vector<const robot::joint*>>(m.select("all"));
-  std::vector<const robot::joint*> chosen;
+std::vector<const rcb4::robot::joint*> joints_of(const rcb4::robot::model& m, const std::vector<std::string>& words) {
+  if (words.empty()) return std::get<std::vector<const rcb4::robot::joint*>>(m.select("all"));
+  std::vector<const rcb4::robot::joint*> chosen;
   for (const auto& w : words) {
     auto sel = m.select(w);
-    if (!robot::ok(sel))
+    if (!rcb4::robot::ok(sel))
       throw usage_error(
-          fmt::format("{} (robot {}: see rcb4 joint list)", std::get<robot::problem>(sel).message, m.name()));
-    for (const auto* j : std::get<std::vector<const robot::joint*>>(sel))
+          fmt::format("{} (robot {}: see rcb4 joint list)", std::get<rcb4::robot::problem>(sel).message, m.name()));
+    for (const auto* j : std::get<std::vector<const rcb4::robot::joint*>>(sel))
       if (std::find(chosen.begin(), chosen.end(), j) == chosen.end()) chosen.push_back(j);
   }
-  std::vector<const robot::joint*> ordered;
+  std::vector<const rcb4::robot::joint*> ordered;
   for (const auto& j : m.joints())
     if (std::find(chosen.begin(), chosen.end(), &j) != chosen.end()) ordered.push_back(&j);
   return ordered;
 }
 
 /** Where the joints are on this board; joints without a block are an error naming them. */
-robot::joint_map locate(session& s, const robot::model& m, const std::vector<const robot::joint*>& need) {
-  auto map = s.run(robot::locate_joints(m));
+rcb4::robot::joint_map locate(session& s, const rcb4::robot::model& m,
+                              const std::vector<const rcb4::robot::joint*>& need) {
+  auto map = s.run(rcb4::robot::locate_joints(m));
   std::vector<std::string> missing;
   for (const auto* j : need)
     if (!map.block_of(*j)) missing.push_back(fmt::format("{} (ICS {})", j->name, j->ics.value()));
@@ -73,8 +56,27 @@ robot::joint_map locate(session& s, const robot::model& m, const std::vector<con
   return map;
 }
 
-std::vector<robot::joint_reading> read_all(session& s, const robot::joint_map& map, robot::fields f) {
-  return s.run(robot::read_joints(map, f, rcb4::ops::link_cost::at(s.baud(), 1ms)));
+std::vector<rcb4::robot::joint_reading> read_all(session& s, const rcb4::robot::joint_map& map, rcb4::robot::fields f) {
+  return s.run(rcb4::robot::read_joints(map, f, rcb4::ops::link_cost::at(s.baud(), std::chrono::milliseconds(1))));
+}
+
+namespace {
+
+using namespace std::chrono_literals;
+namespace robot = rcb4::robot;
+
+/** Degrees to a hundredth for JSON, without -0; null for none. */
+json rounded(std::optional<double> d) {
+  if (!d) return nullptr;
+  const double r = std::round(*d * 100) / 100;
+  return r == 0 ? 0.0 : r;
+}
+
+/** Degrees to a tenth, signed, without "-0.0"; "-" for none. */
+std::string deg_text(std::optional<double> d) {
+  if (!d) return "-";
+  const double tenths = std::round(*d * 10) / 10;
+  return fmt::format("{:+.1f}", tenths == 0 ? 0.0 : tenths);
 }
 
 /** Checked targets, or a usage error (exit 2, nothing sent) naming the joint and the limit. */
@@ -542,7 +544,7 @@ void add_scan(CLI::App& app, context& ctx) {
       app.add_subcommand("scan", "which servo slots the board allocates, which answer, and the robot's joints on them");
   on_device(scan, ctx, [&ctx](session& s) {
     const auto& m = robot_of(ctx.g);
-    const auto probes = s.run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(s.baud(), 1ms)));
+    const auto probes = s.run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(s.baud(), std::chrono::milliseconds(1))));
     std::vector<std::string> missing;
     for (const auto& j : m.joints())
       if (std::none_of(probes.begin(), probes.end(), [&](const auto& p) { return p.ics == j.ics; }))

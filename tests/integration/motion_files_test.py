@@ -9,6 +9,7 @@
 import glob
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -261,6 +262,51 @@ srv.wait(timeout=10)
 image = open(rom2, "rb").read()
 check(srv.returncode == 0 and image[0x2B80:0x2B88] == b"\xff" * 8, f"SIGHUP saves the ROM too ({srv.returncode})")
 
+# Teaching by demonstration, against a board of our own whose servo a "hand" turns (the stand-in's
+# RAM, changed by this script while the tool samples): still, to +40 deg, still, back to 0.
+hand = StandIn()
+def head_at(deg):
+    hand.ram[0x90 + 4:0x90 + 6] = int(round(7500 + deg * 8000 / 270)).to_bytes(2, "little")
+head_at(0)
+rec = subprocess.Popen([RCB4, "--device", hand.path, "motion", "record", "taught.yaml", "--joints", "head_yaw",
+                        "--every", "50", "--free", "--for", "3"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+t0 = time.monotonic()
+def at(t):
+    while time.monotonic() - t0 < t:
+        time.sleep(0.005)
+at(0.7)
+for k in range(1, 11):   # +40 deg over 0.5 s
+    head_at(4 * k)
+    at(0.7 + 0.05 * k)
+at(1.8)
+for k in range(1, 11):   # back over 0.5 s
+    head_at(40 - 4 * k)
+    at(1.8 + 0.05 * k)
+out, err = rec.communicate(timeout=20)
+taught = open("taught.yaml").read() if os.path.exists("taught.yaml") else ""
+poses = [l for l in taught.splitlines() if l.strip().startswith("- pose:")]
+times = [int(l.split(":")[1]) for l in taught.splitlines() if l.strip().startswith("time_ms:")]
+peak = max((float(l.split("head_yaw:")[1].strip(" }")) for l in poses), default=0)
+check(rec.returncode == 0 and 4 <= len(poses) <= 8 and abs(peak - 40) <= 2 and "period_ms: 10" in taught,
+      f"motion record: a few poses, the turn at +40 deg ({rec.returncode}: {len(poses)} poses, peak {peak}, {err.strip()[-200:]!r})")
+check(2.8 <= sum(times[1:]) / 1000 <= 3.3 and all(t % 10 == 0 for t in times), f"the poses' times add up to the 3 s recorded ({times})")
+consts = [f for f in hand.frames if f[1] == 0x10]
+check(len(consts) >= 2 and b"\x00\x80" in bytes(consts[0]) and b"\xff\x7f" in bytes(consts[-1]),
+      "--free: the joint freed first (0x8000) and held at the end (0x7FFF)")
+rc, out, err = run("--device", StandIn().path, "motion", "record", "legs.yaml", "--joints", "legs", "--for", "1")
+check(rc == 1 and "no servo allocated for left_hip_roll" in err and not os.path.exists("legs.yaml"),
+      f"record of joints the board has no servo for: exit 1 ({rc}: {err.strip()!r})")
+rec = subprocess.Popen([RCB4, "--device", StandIn().path, "motion", "record", "stopped.yaml", "--joints", "head_yaw"],
+                       stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+time.sleep(1.0)
+rec.send_signal(signal.SIGINT)
+out, err = rec.communicate(timeout=10)
+check(rec.returncode == 0 and os.path.exists("stopped.yaml") and "recorded 2 poses" in out,
+      f"Ctrl-C ends a recording and saves it ({rec.returncode}: {out.strip()!r} {err.strip()[-200:]!r})")
+run("--device", StandIn().path, "motion", "record", "stopped.yaml", "--joints", "head_yaw", "--for", "0.2")
+rc, out, err = run("--device", StandIn().path, "motion", "record", "stopped.yaml", "--for", "0.2")
+check(rc == 2 and "exists" in err, f"record does not replace a file ({rc}: {err.strip()!r})")
+
 # Boards that are not ours.
 board = StandIn()  # acknowledges ROM writes and keeps nothing
 rc, out, err = run("--device", board.path, "motion", "push", "knee10.yaml", "1", "--layout", "2.2", "--backup", "x.bin")
@@ -274,4 +320,6 @@ check(rc == 1, f"a board that NACKs: exit 1 ({rc}: {err.strip()!r})")
 rc, out, err = run("--device", "/dev/rcb4-no-such-port", "rom", "backup", "n.bin")
 check(rc == 3 and not os.path.exists("n.bin"), f"no such device: exit 3 ({rc}: {err.strip()!r})")
 
+os.chdir("/")
+shutil.rmtree(work, ignore_errors=True)
 finish()
