@@ -329,6 +329,14 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: "watching" in driver.find_element(By.ID, "role").text), "a second tab watches")
         check(not driver.find_element(By.CSS_SELECTOR, 'input[data-joint="head_yaw"]').is_enabled() and
               not driver.find_element(By.ID, "capture").is_enabled(), "its sliders and buttons are disabled")
+        # Reading a ROM motion as a motion file is for any page: the watching tab asks for motion 2.
+        driver.find_element(By.CSS_SELECTOR, '#motions li[data-motion="2"] button[title^="the motion as"]').click()
+        text = wait_until(lambda: driver.find_element(By.ID, "motion-file-text").text or None)
+        check(text and "period_ms: 10" in text and "right_shoulder_pitch: 67.5" in text and text.rstrip().endswith("- end"),
+              f"YAML: motion 2 as a motion file, in degrees and ms ({(text or '')[:160]!r})")
+        check(driver.find_element(By.ID, "motion-file-save").get_attribute("download") == "wave.yaml" and
+              "beyond its upper limit 100" in driver.find_element(By.ID, "motion-file-problem").text,
+              "saved as wave.yaml, with the limit it breaks said")
         driver.close()
         driver.switch_to.window(driver.window_handles[0])
         time.sleep(1.5)  # let the 30 s plots gather a little for the picture

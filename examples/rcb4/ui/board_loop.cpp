@@ -2,6 +2,9 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "board_loop.hpp"
 
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/robot/motion_file.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <system_error>
@@ -236,6 +239,8 @@ class loop {
             return "motion_play";
           else if constexpr (std::is_same_v<B, motion_stop_action>)
             return "motion_stop";
+          else if constexpr (std::is_same_v<B, motion_file_action>)
+            return "motion_file";
           else
             return "refresh";
         },
@@ -461,6 +466,29 @@ class loop {
   json act(const refresh_action&) {
     refresh_lists();
     return nullptr;
+  }
+
+  /** The slot read back as `rcb4 motion pull` writes it. */
+  json act(const motion_file_action& a) {
+    const auto where = rcb4::motion::slot_of(*o_.layout, a.slot);
+    if (!where || a.slot > o_.layout->motion_count)
+      throw refusal{
+          fmt::format("motion {} is outside this board's layout ({} slots)", a.slot, o_.layout->motion_count)};
+    const auto bytes = must(ops::read_memory(ops::memory::rom, where->address.value(), where->size), "read the motion");
+    if (bytes.empty() || bytes[0] == 0xFF) throw refusal{fmt::format("motion {} is empty", a.slot)};
+    const auto l = rcb4::motion::disassemble(bytes, *where);
+    if (!l.problems.empty()) throw refusal{fmt::format("motion {}: {}", a.slot, l.problems.front())};
+    const auto p = rcb4::motion::lift(l);
+    if (!rcb4::motion::ok(p))
+      throw refusal{fmt::format("motion {} is code a motion file cannot say: {} (rcb4 motion show {} lists it)", a.slot,
+                                std::get<rcb4::motion::failure>(p).message, a.slot)};
+    auto d = robot::from_program(std::get<rcb4::motion::program>(p), m_, *o_.layout, period_);
+    d.name = std::string(m_.motion(a.slot));
+    const auto again = robot::to_program(d, m_, *o_.layout, period_);
+    return json{{"slot", a.slot},
+                {"name", d.name},
+                {"yaml", robot::motion_yaml(d, fmt::format("motion {} of the board, read by rcb4 ui", a.slot))},
+                {"problem", robot::ok(again) ? json(nullptr) : json(std::get<robot::problem>(again).message)}};
   }
 
   session& s_;

@@ -163,6 +163,10 @@ void controller::handle(client_id c, const message& m, effects& e) {
     e.actions.push_back({c, m.id, refresh_action{}});
     return;
   }
+  if (const auto* mf = std::get_if<motion_file_request>(&m.body)) {  // reading too
+    e.actions.push_back({c, m.id, motion_file_action{mf->slot}});
+    return;
+  }
   if (controller_ != c) {
     refuse("this page only watches: take control first");
     return;

@@ -75,13 +75,17 @@ struct motion_play_action {
 struct motion_stop_action {};
 /** Read the pose and motion lists again. */
 struct refresh_action {};
+/** Read ROM motion @p slot and give it back as a motion file. */
+struct motion_file_action {
+  unsigned slot = 0;  ///< 1..120
+};
 
 /** What the board loop does for a page. */
 struct action {
   client_id from = 0;              ///< the page that asked (0: the server itself)
   std::optional<std::int64_t> id;  ///< the page's id for the answer
   std::variant<move_action, power_action, stop_action, capture_action, play_pose_action, motion_play_action,
-               motion_stop_action, refresh_action>
+               motion_stop_action, refresh_action, motion_file_action>
       body;  ///< what to do
 };
 

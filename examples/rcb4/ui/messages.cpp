@@ -158,9 +158,17 @@ request body_of(const json& o, const std::string& op) {
     if (v < 1 || v > 120) throw refused{"motion_play: slot " + std::to_string(v) + " is outside 1..120"};
     return motion_play_request{static_cast<unsigned>(v)};
   }
+  if (op == "motion_file") {
+    only_keys(o, op, {"op", "id", "slot"});
+    const auto& s = required(o, op, "slot");
+    if (!s.is_number_integer()) throw refused{"motion_file: 'slot' must be a whole number"};
+    const auto v = s.get<std::int64_t>();
+    if (v < 1 || v > 120) throw refused{"motion_file: slot " + std::to_string(v) + " is outside 1..120"};
+    return motion_file_request{static_cast<unsigned>(v)};
+  }
   throw refused{"unknown op " + shown(op) +
                 " (known: control, release, move, free, hold, stop, capture, play_pose, motion_play, "
-                "motion_stop, refresh)"};
+                "motion_stop, refresh, motion_file)"};
 }
 
 }  // namespace
@@ -185,6 +193,7 @@ std::string_view op_name(const request& r) noexcept {
     std::string_view operator()(const motion_play_request&) const { return "motion_play"; }
     std::string_view operator()(const motion_stop_request&) const { return "motion_stop"; }
     std::string_view operator()(const refresh_request&) const { return "refresh"; }
+    std::string_view operator()(const motion_file_request&) const { return "motion_file"; }
   };
   return std::visit(namer{}, r);
 }

@@ -14,6 +14,7 @@
 //   {"op":"play_pose","name":"wave","ms":1200}         play a saved pose
 //   {"op":"motion_play","slot":2}, {"op":"motion_stop"} the ROM motions
 //   {"op":"refresh"}                                   read the pose and motion lists again
+//   {"op":"motion_file","slot":2}                      ROM motion 2 as a motion file (YAML text; any page)
 //
 // Anything else (not JSON, an unknown op or key, a wrong type, a value out of range, more than
 // max_message_bytes, nesting deeper than an object of arrays) is a parse_error with the reason.
@@ -70,10 +71,15 @@ struct motion_play_request {
 struct motion_stop_request {};
 /** {"op":"refresh"}: read the saved poses and the motion slots again. */
 struct refresh_request {};
+/** {"op":"motion_file"}: ROM motion @p slot read back as a motion file (reading only: any page may ask). */
+struct motion_file_request {
+  unsigned slot = 0;  ///< 1..120
+};
 
 /** What a page asks. */
-using request = std::variant<take_control, release_control, move_request, power_request, stop_request, capture_request,
-                             play_pose_request, motion_play_request, motion_stop_request, refresh_request>;
+using request =
+    std::variant<take_control, release_control, move_request, power_request, stop_request, capture_request,
+                 play_pose_request, motion_play_request, motion_stop_request, refresh_request, motion_file_request>;
 
 /** A well-formed message: its request and the id to answer with. */
 struct message {

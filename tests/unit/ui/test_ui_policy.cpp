@@ -101,6 +101,8 @@ TEST_CASE("ui messages: bad ones are refused with the reason", "[ui]") {
   CHECK(parse_failure(R"({"op":"capture","name":""})") == "capture: 'name' must be 1..64 bytes");
   CHECK(parse_failure(R"({"op":"capture","name":"a","force":1})") == "capture: 'force' must be true or false");
   CHECK(parse_failure(R"({"op":"motion_play","slot":0})") == "motion_play: slot 0 is outside 1..120");
+  CHECK(parse_failure(R"({"op":"motion_file","slot":121})") == "motion_file: slot 121 is outside 1..120");
+  CHECK(parse_failure(R"({"op":"motion_file","slot":"2"})") == "motion_file: 'slot' must be a whole number");
   CHECK(parse_failure(R"({"op":"motion_play","slot":"2"})") == "motion_play: 'slot' must be a whole number");
   CHECK(parse_failure(R"({"op":"stop","op":"move"})") == "a key is given twice");
   CHECK(parse_failure(R"({"op":"move","joints":{"a":1,"a":2}})") == "a key is given twice");
@@ -138,6 +140,11 @@ TEST_CASE("ui controller: the first page controls, the others watch", "[ui]") {
   e = c.receive(2, R"({"op":"refresh"})", t0);
   REQUIRE(e.actions.size() == 1);
   CHECK(std::holds_alternative<refresh_action>(e.actions[0].body));
+  // And reading a motion slot as a motion file.
+  e = c.receive(2, R"({"op":"motion_file","slot":2,"id":9})", t0);
+  REQUIRE(e.actions.size() == 1);
+  CHECK(std::get<motion_file_action>(e.actions[0].body).slot == 2u);
+  CHECK(e.actions[0].id == 9);
 
   // Released: the watcher may take it; both pages hear the new roles.
   e = c.receive(1, R"({"op":"release","id":1})", t0);

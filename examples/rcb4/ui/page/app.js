@@ -94,6 +94,7 @@ const on = {
         (m.clamped?.length ? ` (saved at the limit: ${m.clamped.join(', ')})` : ''),
       play_pose: () => `playing ${m.name} over ${m.ms} ms`,
       motion_play: () => `playing motion ${m.slot}`,
+      motion_file: () => showMotionFile(m),
       motion_stop: () => 'motion stopped',
       stop: () => 'stopped: every joint holds where it is',
       free: () => `${m.joints} joints free` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
@@ -270,11 +271,26 @@ function playPose(name) {
   send({ op: 'play_pose', name, ms: Number.isFinite(ms) ? Math.min(Math.max(Math.round(ms), 0), 6375) : undefined });
 }
 
+// A ROM motion read back as a motion file: shown, and saved by the browser (rcb4 motion push reads it).
+function showMotionFile(m) {
+  const name = (m.name || `motion-${m.slot}`) + '.yaml';
+  $('#motion-file-title').textContent = `motion ${m.slot}` + (m.name ? ` (${m.name})` : '');
+  $('#motion-file-text').textContent = m.yaml;
+  $('#motion-file-problem').textContent = m.problem ? `as it is, it would not push back: ${m.problem}` : '';
+  const link = $('#motion-file-save');
+  if (link.href) URL.revokeObjectURL(link.href);
+  link.href = URL.createObjectURL(new Blob([m.yaml], { type: 'application/yaml' }));
+  link.download = name;
+  $('#motion-file').hidden = false;
+  return `motion ${m.slot} as a motion file`;
+}
+
 function renderMotions() {
   const list = $('#motions');
   list.replaceChildren(...ui.motions.map((m) => el('li', { 'data-motion': m.slot },
     el('span', { text: `${m.slot} ${m.name ?? ''}`.trim() + (m.readable ? '' : ' (unreadable)') }),
-    el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'motion_play', slot: m.slot }) }, 'Play'))));
+    el('button', { type: 'button', class: 'needs-control', onclick: () => send({ op: 'motion_play', slot: m.slot }) }, 'Play'),
+    el('button', { type: 'button', title: 'the motion as a motion file (rcb4 motion pull)', onclick: () => send({ op: 'motion_file', slot: m.slot }) }, 'YAML'))));
   if (!ui.motions.length) list.append(el('li', { class: 'muted', text: 'no motion in ROM' }));
   setRole(ui.role, ui.controlled);
 }
