@@ -1,0 +1,296 @@
+// pyrcb4: the Board in C++ (see board.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include "board.hpp"
+
+#include <rcb4/motion/buttons.hpp>
+#include <rcb4/ops/layout.hpp>
+#include <rcb4/transport/detect.hpp>
+#include <rcb4/transport/serial.hpp>
+#include <rcb4/transport/tcp.hpp>
+
+#include <termios.h>
+#include <unistd.h>
+
+#include <thread>
+
+namespace pyrcb4 {
+
+namespace t = rcb4::transport;
+
+void raise(const std::error_code& ec, const std::string& what) {
+  const std::string text = what.empty() ? ec.message() : what + ": " + ec.message();
+  if (ec.category() == rcb4::codec_category()) {
+    if (ec == rcb4::errc::nack) throw board_error(fault::refused, text + " (the board answered NACK)");
+    throw board_error(fault::bad_reply, text);
+  }
+  if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board)
+    throw board_error(
+        fault::timeout,
+        text + " (is the board powered, the cable in, the baud right? a slow link needs a longer timeout)");
+  if (ec == t::transport_errc::truncated || ec == t::transport_errc::echo) throw board_error(fault::bad_reply, text);
+  if (ec == std::errc::inappropriate_io_control_operation)
+    throw board_error(fault::device, what + ": not a serial port");
+  throw board_error(fault::device, text);
+}
+
+namespace {
+stream adopt(boost::asio::io_context& io, int fd) {
+  const int own = ::dup(fd);
+  if (own < 0) throw board_error(fault::device, std::string("dup: ") + std::strerror(errno));
+  return stream(io, own);
+}
+
+rcb4::robot::model open_robot(const std::string& robot) {
+  try {
+    return rcb4::robot::open_profile(robot);
+  } catch (const rcb4::robot::profile_error& e) {
+    throw board_error(fault::usage, std::string("robot: ") + e.what());
+  }
+}
+}  // namespace
+
+board::board(const std::string& device, std::uint32_t baud, const std::string& robot, std::chrono::milliseconds timeout)
+    : model_(open_robot(robot)) {
+  if (baud != 0 && baud != 115200 && baud != 625000 && baud != 1250000)
+    throw board_error(fault::usage, "baud: the RCB-4 speaks 115200, 625000 or 1250000, not " + std::to_string(baud));
+  if (timeout.count() <= 0) throw board_error(fault::usage, "timeout: must be more than 0 seconds");
+  t::client_options opt;
+  opt.turnaround = timeout;
+  std::string path = device;
+  if (path.empty()) {
+    rcb4::board::options o;
+    o.servos = model_.mask();  // the virtual board is the robot the profile describes
+    board_ = std::make_unique<rcb4::board::virtual_board>(o);
+    board_io_ = std::make_unique<t::io_thread>();
+    server_ = t::board_server::serve_pty(board_io_->context(), *board_);
+    path = server_->where();
+    where_ = "the in-process virtual board (" + path + ")";
+  } else {
+    where_ = path;
+  }
+  io_ = std::make_unique<t::io_thread>();
+  t::error_code ec;
+  if (path.rfind("tcp:", 0) == 0) {
+    auto socket = t::connect(io_->context(), path.substr(4), ec);
+    if (ec) raise(ec, path);
+    opt.baud = baud ? baud : 115200;  // the bridge's rate is unknown: the slowest gives safe deadlines
+    client_ = std::make_unique<client>(adopt(io_->context(), socket.native_handle()), opt);
+  } else {
+    if (baud == 0) {
+      t::detect_options how;
+      how.turnaround = std::max(timeout, std::chrono::milliseconds(50));
+      baud = t::detect_baud(io_->context(), path, ec, how);
+      if (ec) raise(ec, path);
+    }
+    auto port = t::open_serial(io_->context(), path, baud, ec);
+    if (ec) raise(ec, path);
+    ::tcflush(port.native_handle(), TCIFLUSH);  // what a previous program left must not answer us
+    opt.baud = baud;
+    client_ = std::make_unique<client>(adopt(io_->context(), port.native_handle()), opt);
+  }
+  client_->execute(rcb4::ping{rcb4::ping_form::short_}, ec);
+  if (ec) {
+    close();
+    raise(ec, where_);
+  }
+}
+
+board::~board() { close(); }
+
+void board::close() {
+  std::unique_lock life(life_);  // waits for calls under way: each ends by its deadline
+  client_.reset();
+  t::board_server::shutdown(server_);
+  board_io_.reset();
+  io_.reset();
+  board_.reset();
+}
+
+bool board::is_open() const {
+  std::shared_lock life(life_);
+  return client_ != nullptr;
+}
+
+std::uint32_t board::baud() const {
+  std::shared_lock life(life_);
+  return client_ ? client_->options().baud : 0;
+}
+
+client& board::c(const char* what) {
+  if (!client_) throw board_error(fault::closed, std::string(what) + ": the board is closed");
+  return *client_;
+}
+
+template <class Op>
+auto board::run(Op op, const char* what) {
+  std::shared_lock life(life_);
+  t::error_code ec;
+  t::run(c(what), op, ec);
+  if (ec) raise(ec, what);
+  return op.value();
+}
+
+double board::ping() {
+  std::shared_lock life(life_);
+  t::error_code ec;
+  const auto start = std::chrono::steady_clock::now();
+  c("ping").execute(rcb4::ping{rcb4::ping_form::short_}, ec);
+  if (ec) raise(ec, "ping");
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+std::string board::version() { return run(rcb4::ops::read_version{}, "version"); }
+
+rcb4::config_word board::config() { return run(rcb4::ops::read_config{}, "config"); }
+
+void board::set_config(const rcb4::config_word& cw) {
+  run(rcb4::ops::detail::ack_sequence({rcb4::ops::detail::write_u16(rcb4::ram::config, cw.encode())}), "set config");
+}
+
+namespace {
+rcb4::ops::memory memory_of(const std::string& m) {
+  if (m == "ram") return rcb4::ops::memory::ram;
+  if (m == "rom") return rcb4::ops::memory::rom;
+  throw board_error(fault::usage, "memory: 'ram' or 'rom', not '" + m + "'");
+}
+}  // namespace
+
+std::vector<std::uint8_t> board::read(const std::string& memory, std::uint32_t address, std::size_t n) {
+  rcb4::ops::read_memory op(memory_of(memory), address, n);
+  if (op.error() != rcb4::errc{})
+    throw board_error(fault::usage, "read " + memory + ": " + std::string(rcb4::message(op.error())));
+  return run(std::move(op), "read");
+}
+
+void board::write(const std::string& memory, std::uint32_t address, const std::vector<std::uint8_t>& data) {
+  rcb4::ops::write_memory op(memory_of(memory), address, data);
+  if (op.error() != rcb4::errc{})
+    throw board_error(fault::usage, "write " + memory + ": " + std::string(rcb4::message(op.error())));
+  run(std::move(op), "write");
+}
+
+const rcb4::robot::joint_map& board::joints_located() {
+  {
+    std::lock_guard lk(state_);
+    if (map_) return *map_;
+  }
+  auto m = run(rcb4::robot::locate_joints(model_), "locate the joints");
+  std::lock_guard lk(state_);
+  if (!map_) map_ = std::move(m);
+  return *map_;
+}
+
+std::vector<std::optional<double>> board::angles() {
+  const auto& map = joints_located();
+  const auto rs = run(rcb4::robot::read_joints(map, rcb4::robot::fields::positions,
+                                               rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))),
+                      "read the joints");
+  std::vector<std::optional<double>> out(model_.joints().size());
+  for (const auto& r : rs)
+    for (std::size_t i = 0; i < model_.joints().size(); ++i)
+      if (r.j == &model_.joints()[i]) out[i] = r.degrees();
+  return out;
+}
+
+double board::move(const std::vector<std::pair<std::string, double>>& targets, double seconds) {
+  if (!(seconds >= 0) || seconds > 6.375) throw board_error(fault::usage, "time: 0 to 6.375 seconds");
+  const auto time = std::chrono::milliseconds(static_cast<long long>(std::llround(seconds * 1000)));
+  std::vector<rcb4::robot::joint_target> ts;
+  for (const auto& [name, deg] : targets) {
+    if (!model_.find(name))
+      throw board_error(fault::usage, "no joint of " + model_.name() + " is called '" + name + "'");
+    ts.push_back({name, deg, std::nullopt});
+  }
+  auto checked = rcb4::robot::check_targets(model_, ts, time);
+  if (!rcb4::robot::ok(checked)) throw board_error(fault::limit, std::get<rcb4::robot::problem>(checked).message);
+  const auto moves = run(rcb4::robot::move_joints(std::get<std::vector<rcb4::robot::joint_move>>(checked)), "move");
+  const auto period = config().period;
+  unsigned longest = 0;
+  for (const auto& mv : moves) longest = std::max(longest, mv.frames);
+  return longest * rcb4::milliseconds(period) / 1000.0;
+}
+
+std::vector<std::string> board::power(bool free, const std::vector<std::string>& words) {
+  std::vector<const rcb4::robot::joint*> js;
+  for (const auto& w : words.empty() ? std::vector<std::string>{"all"} : words) {
+    const auto sel = model_.select(w);
+    if (!rcb4::robot::ok(sel)) throw board_error(fault::usage, std::get<rcb4::robot::problem>(sel).message);
+    for (const auto* j : std::get<std::vector<const rcb4::robot::joint*>>(sel))
+      if (std::find(js.begin(), js.end(), j) == js.end()) js.push_back(j);
+  }
+  const auto& map = joints_located();
+  rcb4::servo_mask mask;
+  std::vector<std::string> done;
+  for (const auto* j : js)
+    if (map.block_of(*j)) {
+      mask.insert(j->ics);
+      done.push_back(j->name);
+    }
+  if (mask.empty()) throw board_error(fault::refused, "none of these joints has a servo on the board");
+  run(rcb4::ops::set_servo_power(free ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, mask),
+      free ? "free" : "hold");
+  return done;
+}
+
+const rcb4::rom_layout& board::layout() {
+  {
+    std::lock_guard lk(state_);
+    if (layout_) return *layout_;
+  }
+  const auto guess = run(rcb4::ops::detect_layout{}, "tell the ROM's layout");
+  if (!guess.layout)
+    throw board_error(fault::refused, "cannot tell which HeartToHeart4 layout the ROM has: " + guess.reason);
+  std::lock_guard lk(state_);
+  layout_ = guess.layout;
+  return *layout_;
+}
+
+void board::play_motion(unsigned n) {
+  const auto& l = layout();
+  if (n < 1 || n > l.motion_count)
+    throw board_error(fault::usage, "motion " + std::to_string(n) + " is outside 1.." + std::to_string(l.motion_count));
+  run(rcb4::ops::play_motion(n, l, rcb4::ops::servo_power::keep), "play the motion");
+}
+
+void board::stop_motion() { run(rcb4::ops::stop_motion{}, "stop the motion"); }
+
+motion_status board::motion() {
+  const auto st = run(rcb4::ops::read_motion_state(layout()), "motion state");
+  return {st.running, st.suspended, st.motion, st.program_counter};
+}
+
+motion_status board::wait_motion(double seconds, const interrupt_check& check) {
+  const auto deadline =
+      std::chrono::steady_clock::now() +
+      std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+  for (;;) {
+    const auto st = motion();
+    if (!st.running) return st;
+    if (std::chrono::steady_clock::now() >= deadline)
+      throw board_error(fault::timeout, "the motion still runs after " + std::to_string(seconds) + " s");
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the board refreshes the state every 50 ms
+    if (check) check();
+  }
+}
+
+std::vector<rcb4::ops::motion_slot> board::motions() {
+  return run(rcb4::ops::list_motions(layout()), "list the motions");
+}
+
+sensor_reading board::sensors() {
+  const auto a = run(rcb4::ops::read_analog{}, "read AD");
+  const auto p = run(rcb4::ops::read_pio{}, "read PIO");
+  const auto r = run(rcb4::ops::read_receiver{}, "read the receiver");
+  sensor_reading s;
+  s.battery_volts = a.battery_volts;
+  s.ad.assign(a.values.begin(), a.values.end());
+  s.pio_direction = p.direction;
+  s.pio_value = p.value;
+  s.buttons = r.buttons;
+  for (const auto& n : rcb4::motion::button_names)
+    if (r.buttons & n.bit) s.button_names.emplace_back(n.name);
+  s.pa.assign(r.analog.begin(), r.analog.end());
+  return s;
+}
+
+}  // namespace pyrcb4

@@ -1,0 +1,142 @@
+// pyrcb4: the Board the Python module wraps, in C++ (no Python here: module.cpp binds it, releases
+// the GIL around what reaches the wire, and turns board_error into the Python exceptions).
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include <rcb4/board/virtual_board.hpp>
+#include <rcb4/ops.hpp>
+#include <rcb4/robot/ops.hpp>
+#include <rcb4/robot/profile.hpp>
+#include <rcb4/transport/board_server.hpp>
+#include <rcb4/transport/client.hpp>
+#include <rcb4/transport/io_thread.hpp>
+#include <rcb4/transport/operations.hpp>
+
+#include <boost/asio/posix/stream_descriptor.hpp>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <shared_mutex>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pyrcb4 {
+
+/** The kinds of failure, one Python exception each (module.cpp). */
+enum class fault { refused, timeout, device, bad_reply, limit, usage, closed };
+
+/** A failure with its kind and a message for a person. */
+struct board_error : std::runtime_error {
+  board_error(fault k, const std::string& what) : std::runtime_error(what), kind(k) {}
+  fault kind;  ///< which exception
+};
+
+/** How long a wait may go on before it checks for Ctrl-C (module.cpp passes PyErr_CheckSignals). */
+using interrupt_check = std::function<void()>;
+
+/** The client over a serial port, a TCP bridge or a pseudo-terminal. */
+using stream = boost::asio::posix::stream_descriptor;
+using client = rcb4::transport::basic_client<stream>;
+
+/** The motion state, as Python sees it. */
+struct motion_status {
+  bool running = false, suspended = false;
+  std::optional<unsigned> motion;
+  std::uint32_t program_counter = 0;
+};
+
+/** One reading of the board's inputs. */
+struct sensor_reading {
+  double battery_volts = 0;
+  std::vector<std::uint16_t> ad;
+  std::uint16_t pio_direction = 0, pio_value = 0, buttons = 0;
+  std::vector<std::string> button_names;
+  std::vector<std::uint8_t> pa;
+};
+
+/** A board: opened on construction, closed by close() or destruction; every call ends by its deadline. */
+class board {
+ public:
+  /**
+   * Opens @p device ("" : an in-process virtual board wired as @p robot; "/dev/ttyUSB0";
+   * "tcp:HOST:PORT") at @p baud (0: detected on a serial port), each exchange allowed @p timeout.
+   */
+  board(const std::string& device, std::uint32_t baud, const std::string& robot, std::chrono::milliseconds timeout);
+  ~board();
+  board(const board&) = delete;
+  board& operator=(const board&) = delete;
+
+  /** Lets the line go; later calls raise a closed error. Safe to call twice. */
+  void close();
+  /** True until close(). */
+  bool is_open() const;
+  /** What was opened, for messages and repr. */
+  const std::string& where() const noexcept { return where_; }
+  /** The line rate in use. */
+  std::uint32_t baud() const;
+  /** The robot model. */
+  const rcb4::robot::model& robot() const noexcept { return model_; }
+
+  /** One round trip; its time in seconds. */
+  double ping();
+  /** The VERSION field's text. */
+  std::string version();
+  /** The config word, decoded. */
+  rcb4::config_word config();
+  /** Writes the config word (RAM: until power-off). */
+  void set_config(const rcb4::config_word& c);
+  /** @p n bytes of "ram" or "rom" from @p address. */
+  std::vector<std::uint8_t> read(const std::string& memory, std::uint32_t address, std::size_t n);
+  /** Writes @p data to "ram" or "rom" at @p address. */
+  void write(const std::string& memory, std::uint32_t address, const std::vector<std::uint8_t>& data);
+
+  /** Every joint's measured angle in degrees, in the profile's order; nothing for a servo that never answered. */
+  std::vector<std::optional<double>> angles();
+  /** Moves joints (name → degrees) over @p seconds, limits checked before anything is sent; returns the seconds it
+   * takes. */
+  double move(const std::vector<std::pair<std::string, double>>& targets, double seconds);
+  /** Frees (no torque) or holds the joints, groups or "all" that @p words name (none: all). */
+  std::vector<std::string> power(bool free, const std::vector<std::string>& words);
+
+  /** Plays ROM motion @p n (the layout told from the ROM). */
+  void play_motion(unsigned n);
+  /** Suspends the ROM program. */
+  void stop_motion();
+  /** Whether a motion runs. */
+  motion_status motion();
+  /** Waits until no motion runs, or @p seconds; @p check runs between polls (Ctrl-C). */
+  motion_status wait_motion(double seconds, const interrupt_check& check);
+  /** The used motion slots: number, name, size. */
+  std::vector<rcb4::ops::motion_slot> motions();
+  /** AD, battery, PIO, buttons. */
+  sensor_reading sensors();
+
+ private:
+  template <class Op>
+  auto run(Op op, const char* what);
+  client& c(const char* what);
+  const rcb4::rom_layout& layout();
+  const rcb4::robot::joint_map& joints_located();
+
+  rcb4::robot::model model_;
+  std::unique_ptr<rcb4::board::virtual_board> board_;
+  std::unique_ptr<rcb4::transport::io_thread> board_io_;
+  std::shared_ptr<rcb4::transport::board_server> server_;
+  std::unique_ptr<rcb4::transport::io_thread> io_;
+  std::unique_ptr<client> client_;
+  std::string where_;
+  mutable std::shared_mutex life_;  // calls hold it shared while they use the line; close() waits for them
+  mutable std::mutex state_;        // guards the caches
+  std::optional<rcb4::robot::joint_map> map_;
+  const rcb4::rom_layout* layout_ = nullptr;
+};
+
+/** Raises the board_error that @p ec is, with @p what (the operation) in its message. */
+[[noreturn]] void raise(const std::error_code& ec, const std::string& what);
+
+}  // namespace pyrcb4

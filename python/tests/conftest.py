@@ -1,0 +1,37 @@
+# pytest fixtures for pyrcb4: the in-process virtual board, `rcb4 serve --pty`, and the stand-in
+# boards of tests/integration (silent, NACK, bad checksums) for the failures.
+# SPDX-License-Identifier: BSL-1.0
+import os
+import subprocess
+import sys
+
+import pytest
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "integration"))
+
+
+def pytest_addoption(parser):
+    parser.addoption("--rcb4", default=os.environ.get("RCB4", "rcb4"), help="the rcb4 tool (for rcb4 serve)")
+
+
+@pytest.fixture(scope="session")
+def rcb4_tool(request):
+    return request.config.getoption("--rcb4")
+
+
+@pytest.fixture
+def served(rcb4_tool):
+    """A device path: `rcb4 serve --pty` for the duration of the test."""
+    srv = subprocess.Popen([rcb4_tool, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+    try:
+        yield srv.stdout.readline().strip()
+    finally:
+        srv.terminate()
+        srv.wait(timeout=10)
+
+
+@pytest.fixture
+def board():
+    import pyrcb4
+    with pyrcb4.Board() as b:
+        yield b

@@ -1,0 +1,180 @@
+# pyrcb4 as a Python user calls it: the in-process virtual board and `rcb4 serve --pty`, every
+# call of the API, and the exceptions bad boards raise (before their timeout, never a hang).
+# SPDX-License-Identifier: BSL-1.0
+import math
+import os
+import re
+import signal
+import subprocess
+import threading
+import time
+
+import numpy
+import pytest
+
+import pyrcb4
+from standin import StandIn
+
+
+def test_version_is_the_projects(rcb4_tool):
+    out = subprocess.run([rcb4_tool, "--version"], capture_output=True, text=True).stdout
+    assert re.fullmatch(r"\d+\.\d+\.\d+", pyrcb4.__version__)
+    assert pyrcb4.__version__ in out
+
+
+def test_exceptions_are_one_hierarchy():
+    for e in (pyrcb4.BoardRefused, pyrcb4.Timeout, pyrcb4.DeviceError, pyrcb4.BadReply, pyrcb4.LimitError,
+              pyrcb4.UsageError):
+        assert issubclass(e, pyrcb4.Error)
+    assert issubclass(pyrcb4.Timeout, TimeoutError) and issubclass(pyrcb4.DeviceError, OSError)
+    assert issubclass(pyrcb4.LimitError, ValueError) and issubclass(pyrcb4.UsageError, ValueError)
+
+
+def test_raw_level(board):
+    assert 0 < board.ping() < 1
+    assert board.version().startswith("CB-4")
+    c = board.config
+    assert c["ics"] and c["period_ms"] == 10 and c["baud"] in (115200, 625000, 1250000)
+    board.write(0x0460, b"\x12\x34")
+    assert board.read(0x0460, 2) == b"\x12\x34"
+    assert len(board.read(0x0000, 1000, memory="rom")) == 1000
+    with pytest.raises(pyrcb4.UsageError, match="'ram' or 'rom'"):
+        board.read(0, 2, memory="eeprom")
+    with pytest.raises(pyrcb4.UsageError):
+        board.read(0x0480, 100)  # past the end of RAM: refused before anything is sent
+
+
+def test_joints_in_degrees_and_numpy(board):
+    j = board.joints()
+    assert list(j) == board.joint_names and len(j) == 20
+    assert all(abs(v) < 0.1 for v in j.values())
+    v = board.angle_vector()
+    assert isinstance(v, numpy.ndarray) and v.shape == (20,) and v.dtype == numpy.float64
+
+
+def test_move_within_limits_and_refused_beyond(board):
+    took = board.move({"left_knee": 40, "head_yaw": -20.5}, time=0.3)
+    assert 0.25 <= took <= 0.35
+    j = board.joints()
+    assert abs(j["left_knee"] - 40) < 0.1 and abs(j["head_yaw"] + 20.5) < 0.1
+    with pytest.raises(pyrcb4.LimitError, match=r"left_knee: 131 degrees is beyond its upper limit 130"):
+        board.move({"left_knee": 131, "head_yaw": 0})
+    assert abs(board.joints()["head_yaw"] + 20.5) < 0.1  # nothing moved: not even the joint within its limit
+    with pytest.raises(pyrcb4.UsageError, match="no joint of KHR-3HV is called 'left_kneee'"):
+        board.move({"left_kneee": 3})
+    with pytest.raises(pyrcb4.UsageError, match="degrees must be a number"):
+        board.move({"left_knee": "ten"})
+    assert numpy.isclose(board.angle_vector()[board.joint_names.index("left_knee")], 40, atol=0.1)
+
+
+def test_free_and_hold(board):
+    assert board.free("left_arm") == ["left_shoulder_pitch", "left_shoulder_roll", "left_elbow_yaw",
+                                       "left_elbow_pitch"]
+    assert len(board.hold()) == 20
+    assert board.free(["head", "right_knee"]) == ["head_yaw", "right_knee"]
+    with pytest.raises(pyrcb4.UsageError):
+        board.free("tail")
+
+
+def test_motions(board):
+    ms = board.motions()
+    assert [(m["slot"], m["name"]) for m in ms] == [(1, "home"), (2, "wave"), (3, "bow")]
+    start = time.monotonic()
+    st = board.play_motion(2)
+    assert 0.5 < time.monotonic() - start < 5 and not st["running"]
+    assert board.play_motion(3, wait=False) is None
+    assert board.motion_status()["motion"] == 3
+    board.stop_motion()
+    assert board.motion_status()["suspended"]
+    with pytest.raises(pyrcb4.UsageError):
+        board.play_motion(121)
+
+
+def test_sensors(board):
+    s = board.sensors()
+    assert 5 < s["battery_volts"] < 20 and len(s["ad"]) == 11 and s["button_names"] == [] and len(s["pa"]) == 4
+
+
+def test_closed_board_and_context_manager():
+    with pyrcb4.Board() as b:
+        assert not b.closed and "virtual" in repr(b)
+    assert b.closed and "closed" in repr(b)
+    with pytest.raises(pyrcb4.UsageError, match="closed"):
+        b.ping()
+    b.close()  # twice is fine
+
+
+def test_served_board_by_path(served):
+    with pyrcb4.Board(served) as b:
+        assert b.where == served and b.baud in (115200, 625000, 1250000)
+        b.move({"left_knee": 20}, time=0.1)
+        assert abs(b.joints()["left_knee"] - 20) < 0.1
+
+
+def test_device_errors():
+    with pytest.raises(pyrcb4.DeviceError, match="No such file"):
+        pyrcb4.Board("/dev/rcb4-no-such-port")
+    with pytest.raises(pyrcb4.DeviceError, match="not a serial port"):
+        pyrcb4.Board("/dev/null", baud=115200)
+    with pytest.raises(pyrcb4.UsageError):
+        pyrcb4.Board("")
+    with pytest.raises(pyrcb4.UsageError, match="115200, 625000 or 1250000"):
+        pyrcb4.Board(baud=9600)
+    with pytest.raises(pyrcb4.UsageError, match="robot"):
+        pyrcb4.Board(robot="no-such-robot")
+
+
+def test_bad_boards_raise_before_their_timeout():
+    start = time.monotonic()
+    with pytest.raises(pyrcb4.Timeout):
+        pyrcb4.Board(StandIn(silent=True).path, baud=115200)
+    assert time.monotonic() - start < 2
+    with pytest.raises(pyrcb4.BoardRefused):
+        pyrcb4.Board(StandIn(mode="nack").path, baud=115200)
+    with pytest.raises(pyrcb4.BadReply):
+        pyrcb4.Board(StandIn(mode="badsum").path, baud=115200)
+    b = pyrcb4.Board(StandIn(mode="die", die_after=3).path, baud=115200)
+    with pytest.raises((pyrcb4.Timeout, pyrcb4.DeviceError)):
+        for _ in range(10):
+            b.version()
+
+
+def test_ctrl_c_interrupts_a_wait_within_100_ms(board):
+    board.play_motion(2, wait=False)
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        board.wait_motion(timeout=10)
+    assert time.monotonic() - start < 0.3 + 0.2
+    board.wait_motion(timeout=10)
+
+
+def test_the_gil_is_released_and_two_threads_share_a_board(board):
+    counted = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counted[0] += 1
+
+    def reads(errors):
+        try:
+            for _ in range(40):
+                assert len(board.joints()) == 20
+                board.ping()
+        except Exception as e:  # noqa: BLE001 (reported below)
+            errors.append(e)
+
+    t = threading.Thread(target=count)
+    t.start()
+    errors = []
+    workers = [threading.Thread(target=reads, args=(errors,)) for _ in range(2)]
+    for w in workers:
+        w.start()
+    board.play_motion(2)  # this thread waits in C++ meanwhile
+    for w in workers:
+        w.join()
+    stop.set()
+    t.join()
+    assert not errors and counted[0] > 1000
