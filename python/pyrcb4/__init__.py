@@ -11,13 +11,16 @@ from ._core import (  # noqa: F401
     BadReply,
     Board,
     BoardRefused,
+    ControlLoop,
     DeviceError,
     Error,
     LimitError,
     Timeout,
     UsageError,
     __version__,
+    load_pose,
+    save_pose,
 )
 
-__all__ = ["Board", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
+__all__ = ["Board", "ControlLoop", "load_pose", "save_pose", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
            "__version__"]

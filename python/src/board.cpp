@@ -11,6 +11,8 @@
 #include <termios.h>
 #include <unistd.h>
 
+#include <cmath>
+#include <limits>
 #include <thread>
 
 namespace pyrcb4 {
@@ -291,6 +293,82 @@ sensor_reading board::sensors() {
     if (r.buttons & n.bit) s.button_names.emplace_back(n.name);
   s.pa.assign(r.analog.begin(), r.analog.end());
   return s;
+}
+
+std::vector<rcb4::robot::joint_reading> board::states() {
+  const auto& map = joints_located();
+  return run(rcb4::robot::read_joints(map, rcb4::robot::fields::state,
+                                      rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))),
+             "read the joints");
+}
+
+void board::set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent) {
+  std::vector<rcb4::robot::joint_trim> ts;
+  for (const auto& [name, deg] : trims) {
+    const auto* j = model_.find(name);
+    if (!j) throw board_error(fault::usage, "no joint of " + model_.name() + " is called '" + name + "'");
+    const auto t = rcb4::robot::trim_of(*j, deg);
+    if (!rcb4::robot::ok(t)) throw board_error(fault::limit, std::get<rcb4::robot::problem>(t).message);
+    ts.push_back(std::get<rcb4::robot::joint_trim>(t));
+  }
+  if (ts.empty()) return;
+  run(rcb4::robot::write_trims(std::move(ts), persistent), "set the trims");
+}
+
+std::vector<rcb4::ops::slot_probe> board::scan() {
+  return run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))), "scan");
+}
+
+// --- control loop ------------------------------------------------------------------------------
+
+control_loop::control_loop(board& b)
+    : b_(b),
+      map_(b.joints_located()),
+      reads_(map_, rcb4::robot::fields::positions, rcb4::ops::link_cost::at(b.baud(), std::chrono::milliseconds(1))),
+      targets_(map_) {
+  const auto js = targets_.joints();
+  for (const auto& j : b.model_.joints()) {
+    const auto it = std::find(js.begin(), js.end(), &j);
+    index_.push_back(it == js.end() ? -1 : it - js.begin());
+  }
+}
+
+void control_loop::read(double* out) {
+  std::shared_lock life(b_.life_);
+  reads_.restart();
+  t::error_code ec;
+  t::run(b_.c("read"), reads_, ec);
+  if (ec) raise(ec, "read the joints");
+  const auto& rs = reads_.value();  // one per profile joint, in its order
+  for (std::size_t i = 0; i < index_.size(); ++i) {
+    const auto d = i < rs.size() ? rs[i].degrees() : std::nullopt;
+    out[i] = d ? *d : std::numeric_limits<double>::quiet_NaN();
+  }
+}
+
+std::optional<std::string> control_loop::set(const double* degrees) {
+  // Every target checked before any is kept: a refused set changes nothing.
+  for (std::size_t i = 0; i < index_.size(); ++i) {
+    if (std::isnan(degrees[i])) continue;
+    const auto& j = b_.model_.joints()[i];
+    if (index_[i] < 0) return j.name + " has no servo on the board";
+    if (const auto p = rcb4::robot::to_position(j, degrees[i]); !rcb4::robot::ok(p))
+      return std::get<rcb4::robot::problem>(p).message;
+  }
+  for (std::size_t i = 0; i < index_.size(); ++i)
+    if (!std::isnan(degrees[i])) targets_.set(static_cast<std::size_t>(index_[i]), degrees[i]);
+  return std::nullopt;
+}
+
+void control_loop::send(unsigned frames) {
+  const auto f = rcb4::frames::make(frames);
+  if (!f) throw board_error(fault::usage, "frames: 0..255");
+  const auto c = targets_.frame(*f);
+  if (!c) raise(c.error(), "write the targets");
+  std::shared_lock life(b_.life_);
+  t::error_code ec;
+  b_.c("write").execute(rcb4::command{*c}, ec);
+  if (ec) raise(ec, "write the targets");
 }
 
 }  // namespace pyrcb4

@@ -116,6 +116,13 @@ class board {
   /** AD, battery, PIO, buttons. */
   sensor_reading sensors();
 
+  /** Every joint's block (trim, measured position, target), in the profile's order; unallocated ones marked. */
+  std::vector<rcb4::robot::joint_reading> states();
+  /** Writes trims (joint → degrees, within ±30) to RAM, and with @p persistent to HTH4's ROM image. */
+  void set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent);
+  /** The allocated servo slots, with their measured positions. */
+  std::vector<rcb4::ops::slot_probe> scan();
+
  private:
   template <class Op>
   auto run(Op op, const char* what);
@@ -123,6 +130,7 @@ class board {
   const rcb4::rom_layout& layout();
   const rcb4::robot::joint_map& joints_located();
 
+  friend class control_loop;
   rcb4::robot::model model_;
   std::unique_ptr<rcb4::board::virtual_board> board_;
   std::unique_ptr<rcb4::transport::io_thread> board_io_;
@@ -134,6 +142,34 @@ class board {
   mutable std::mutex state_;        // guards the caches
   std::optional<rcb4::robot::joint_map> map_;
   const rcb4::rom_layout* layout_ = nullptr;
+};
+
+/**
+ * The read and write halves of a control loop over every located joint: the reads the planner
+ * chose (planned once), one CONST of every target per write; nothing allocated per cycle here.
+ */
+class control_loop {
+ public:
+  /** Plans the reads of @p b's located joints. */
+  explicit control_loop(board& b);
+  /** The joints, in the order read() and set() use (the profile's). */
+  std::size_t size() const noexcept { return index_.size(); }
+  /** Reads every joint's angle into @p out (size() values; NaN: no servo, or it never answered). */
+  void read(double* out);
+  /**
+   * Takes the targets (size() degrees; NaN keeps a joint's previous target, HOLD at first). A
+   * target beyond a limit: the problem, and none of the new targets is kept.
+   */
+  std::optional<std::string> set(const double* degrees);
+  /** Sends every target as one CONST, reached in @p frames output periods. */
+  void send(unsigned frames);
+
+ private:
+  board& b_;
+  rcb4::robot::joint_map map_;
+  rcb4::robot::read_joints reads_;
+  rcb4::robot::joint_targets targets_;
+  std::vector<std::ptrdiff_t> index_;  // profile joint → its place in targets_.joints(), or -1
 };
 
 /** Raises the board_error that @p ec is, with @p what (the operation) in its message. */

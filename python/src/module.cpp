@@ -2,7 +2,7 @@
 // GIL is released while the wire is used, waits check for Ctrl-C every 50 ms, and every failure
 // is one of the module's exceptions, whose message is the C++ one.
 // SPDX-License-Identifier: BSL-1.0
-#include "board.hpp"
+#include "common.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -49,27 +49,6 @@ PyObject* class_of(fault k) {
   return exc.error;
 }
 
-/** Raises KeyboardInterrupt (or what a signal handler raised) when a signal came: call with the GIL. */
-void check_signals() {
-  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-}
-
-/** Sleeps @p seconds with the GIL released, looking at signals every 50 ms. */
-void sleep_interruptible(double seconds) {
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                            std::chrono::duration<double>(seconds));
-  for (;;) {
-    const auto now = std::chrono::steady_clock::now();
-    if (now >= until) return;
-    {
-      py::gil_scoped_release release;
-      std::this_thread::sleep_for(
-          std::min<std::chrono::steady_clock::duration>(until - now, std::chrono::milliseconds(50)));
-    }
-    check_signals();
-  }
-}
-
 py::dict config_dict(const rcb4::config_word& c) {
   return py::dict("word"_a = c.encode(), "ics"_a = c.ics_enabled, "program"_a = c.rom_program,
                   "interp_message"_a = c.interpolation_message, "vector_jump"_a = c.vector_jump,
@@ -82,24 +61,6 @@ py::dict status_dict(const motion_status& s) {
   return py::dict("running"_a = s.running, "suspended"_a = s.suspended,
                   "motion"_a = s.motion ? py::object(py::int_(*s.motion)) : py::object(py::none()),
                   "program_counter"_a = s.program_counter);
-}
-
-/** Names from *args: strings, or lists/tuples of them (free("left_arm", "head"), free(["legs"])). */
-std::vector<std::string> names_of(const py::args& args) {
-  std::vector<std::string> out;
-  for (const auto& a : args) {
-    if (py::isinstance<py::str>(a)) {
-      out.push_back(a.cast<std::string>());
-    } else if (py::isinstance<py::list>(a) || py::isinstance<py::tuple>(a)) {
-      for (const auto& x : a) {
-        if (!py::isinstance<py::str>(x)) throw board_error(fault::usage, "joint and group names are strings");
-        out.push_back(x.cast<std::string>());
-      }
-    } else {
-      throw board_error(fault::usage, "joint and group names are strings");
-    }
-  }
-  return out;
 }
 
 std::unique_ptr<board> open_board(const py::object& device, const py::object& baud, const std::string& robot,
@@ -147,16 +108,16 @@ PYBIND11_MODULE(_core, m) {
     }
   });
 
-  py::class_<board>(m, "Board", R"(An RCB-4 board.
+  py::class_<board> cls(m, "Board", R"(An RCB-4 board.
 
 Board(device=None, baud=None, robot="khr-3hv", timeout=0.1)
 
 device: None for an in-process virtual board (every example runs without hardware), a serial
 port ("/dev/ttyUSB0"), or "tcp:HOST:PORT" for a bridge. baud: 115200, 625000 or 1250000;
 None detects it on a serial port. robot: a built-in profile ("khr-3hv", "kxr-l2") or a profile
-file. timeout: seconds each exchange may take. Use it as a context manager, or call close().)")
-      .def(py::init(&open_board), "device"_a = py::none(), "baud"_a = py::none(), "robot"_a = "khr-3hv",
-           "timeout"_a = 0.1)
+file. timeout: seconds each exchange may take. Use it as a context manager, or call close().)");
+  cls.def(py::init(&open_board), "device"_a = py::none(), "baud"_a = py::none(), "robot"_a = "khr-3hv",
+          "timeout"_a = 0.1)
       .def(
           "__enter__", [](board& b) -> board& { return b; }, py::return_value_policy::reference)
       .def("__exit__",
@@ -359,4 +320,5 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
                             "pa"_a = s.pa);
           },
           "AD0..AD10, battery volts, PIO, KRR buttons and PA1..PA4.");
+  bind_robot(m, cls);
 }

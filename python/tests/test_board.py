@@ -178,3 +178,59 @@ def test_the_gil_is_released_and_two_threads_share_a_board(board):
     stop.set()
     t.join()
     assert not errors and counted[0] > 1000
+
+
+def test_poses_capture_play_and_files(board, tmp_path, rcb4_tool):
+    board.move({"left_knee": 30, "head_yaw": 15}, time=0.1)
+    pose = board.capture()
+    assert len(pose) == 20 and abs(pose["left_knee"] - 30) < 0.1
+    path = tmp_path / "bent.yaml"
+    pyrcb4.save_pose(path, pose, time=0.2)
+    r = subprocess.run([rcb4_tool, "pose", "show", str(path)], capture_output=True, text=True)
+    assert r.returncode == 0 and "left_knee" in r.stdout  # the tool reads what Python wrote
+    loaded = pyrcb4.load_pose(path)
+    assert loaded["robot"] == "KHR-3HV" and loaded["time"] == 0.2 and abs(loaded["joints"]["head_yaw"] - 15) < 0.1
+    board.move({"left_knee": 0, "head_yaw": 0}, time=0.1)
+    assert 0.15 < board.play(path) < 0.25  # the file's 200 ms
+    assert abs(board.joints()["left_knee"] - 30) < 0.1
+    board.play({"left_knee": -10}, time=0.1)
+    assert abs(board.joints()["left_knee"] + 10) < 0.1
+    with pytest.raises(pyrcb4.LimitError, match="head_yaw: 95 degrees is beyond its upper limit 90"):
+        board.play({"head_yaw": 95})
+    with pytest.raises(pyrcb4.UsageError, match="missing.yaml"):
+        board.play(tmp_path / "missing.yaml")
+    with pytest.raises(pyrcb4.UsageError, match="no joint of KHR-3HV"):
+        pyrcb4.save_pose(tmp_path / "x.yaml", {"tail": 3})
+
+
+def test_trims_servos_and_scan(board):
+    board.set_trims({"left_knee": 2.5})
+    assert abs(board.trims()["left_knee"] - 2.5) < 0.05
+    with pytest.raises(pyrcb4.LimitError, match="within ±30 degrees"):
+        board.set_trims({"left_knee": 31})
+    s = board.servos()
+    assert sorted(s) == [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21]
+    assert s[16]["joint"] == "left_knee" and s[16]["answered"] and s[16]["trim"] > 0
+    scan = board.scan()
+    assert len(scan) == 20 and all(p["answers"] for p in scan) and scan[0]["joint"] == "head_yaw"
+
+
+def test_control_loop(board):
+    loop = board.control_loop()
+    assert loop.size == 20
+    q = loop.read()
+    assert q.shape == (20,) and numpy.all(numpy.abs(q) < 0.1)
+    k = board.joint_names.index("left_knee")
+    target = numpy.full(20, numpy.nan)
+    target[k] = 25.0
+    loop.write(target, frames=1)
+    time.sleep(0.05)
+    same = loop.read(out=q)
+    assert same is q and abs(q[k] - 25) < 0.1
+    target[k] = 131.0
+    with pytest.raises(pyrcb4.LimitError, match="left_knee: 131 degrees is beyond its upper limit 130"):
+        loop.write(target)
+    time.sleep(0.05)
+    assert abs(loop.read()[k] - 25) < 0.1  # nothing was sent
+    with pytest.raises(pyrcb4.UsageError):
+        loop.write(numpy.zeros(3))

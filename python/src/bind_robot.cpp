@@ -1,0 +1,225 @@
+// pyrcb4: poses (capture, play, the tool's JSON/YAML pose files), trims, scan, servo blocks and
+// the control loop, bound to Python.
+// SPDX-License-Identifier: BSL-1.0
+#include "common.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <limits>
+
+using namespace pybind11::literals;
+
+namespace pyrcb4 {
+namespace {
+
+/** A pose from Python: a dict {joint: degrees}, or a pose file (str or path); its time when the file says. */
+std::pair<std::vector<std::pair<std::string, double>>, std::optional<double>> pose_of(board& b,
+                                                                                      const py::object& pose) {
+  std::vector<std::pair<std::string, double>> joints;
+  if (py::isinstance<py::dict>(pose)) {
+    for (const auto& [k, v] : pose.cast<py::dict>()) {
+      if (!py::isinstance<py::str>(k)) throw board_error(fault::usage, "a pose's joint names are strings");
+      try {
+        joints.emplace_back(k.cast<std::string>(), v.cast<double>());
+      } catch (const py::cast_error&) {
+        throw board_error(fault::usage, k.cast<std::string>() + ": degrees must be a number");
+      }
+    }
+    return {joints, std::nullopt};
+  }
+  if (!py::isinstance<py::str>(pose) && !py::hasattr(pose, "__fspath__"))
+    throw board_error(fault::usage, "a pose is a dict {joint: degrees} or a pose file's path");
+  const std::string path = py::str(py::module_::import("os").attr("fspath")(pose)).cast<std::string>();
+  try {
+    const auto p = rcb4::robot::load_pose(path, b.robot());
+    std::optional<double> t;
+    if (p.time) t = static_cast<double>(p.time->count()) / 1000.0;
+    return {p.joints, t};
+  } catch (const rcb4::robot::profile_error& e) {
+    throw board_error(fault::usage, e.what());
+  }
+}
+
+py::dict joints_dict(const std::vector<std::pair<std::string, double>>& joints) {
+  py::dict d;
+  for (const auto& [n, v] : joints) d[py::str(n)] = v;
+  return d;
+}
+
+}  // namespace
+
+void bind_robot(py::module_& m, py::class_<board>& cls) {
+  cls.def(
+         "capture",
+         [](board& b) {
+           std::vector<std::optional<double>> a;
+           {
+             py::gil_scoped_release release;
+             a = b.angles();
+           }
+           py::dict d;
+           for (std::size_t i = 0; i < a.size(); ++i)
+             if (a[i]) d[py::str(b.robot().joints()[i].name)] = std::round(*a[i] * 100) / 100;
+           return d;
+         },
+         "The pose the robot is in: {joint: degrees} for every joint that answers (save it with pyrcb4.save_pose).")
+      .def(
+          "play",
+          [](board& b, const py::object& pose, std::optional<double> time, bool wait) {
+            auto [joints, file_time] = pose_of(b, pose);
+            const double t = time.value_or(file_time.value_or(1.0));
+            double takes = 0;
+            {
+              py::gil_scoped_release release;
+              takes = b.move(joints, t);
+            }
+            if (wait) sleep_interruptible(takes);
+            return takes;
+          },
+          "pose"_a, "time"_a = py::none(), "wait"_a = true,
+          "Moves to a pose: a dict {joint: degrees} or a pose file (JSON/YAML, as rcb4 pose writes); time in "
+          "seconds (default: the file's time_ms, else 1 s). Limits are checked before anything is sent.")
+      .def(
+          "trims",
+          [](board& b) {
+            std::vector<rcb4::robot::joint_reading> rs;
+            {
+              py::gil_scoped_release release;
+              rs = b.states();
+            }
+            py::dict d;
+            for (const auto& r : rs)
+              if (r.allocated) d[py::str(r.j->name)] = std::round(rcb4::robot::trim_degrees(*r.j, r.trim) * 100) / 100;
+            return d;
+          },
+          "Every joint's trim in degrees (joints without a servo left out).")
+      .def(
+          "set_trims",
+          [](board& b, const py::dict& trims, bool persistent) {
+            std::vector<std::pair<std::string, double>> ts;
+            for (const auto& [k, v] : trims) ts.emplace_back(k.cast<std::string>(), v.cast<double>());
+            py::gil_scoped_release release;
+            b.set_trims(ts, persistent);
+          },
+          "trims"_a, "persistent"_a = false,
+          "Sets trims {joint: degrees} (within ±30; LimitError beyond); persistent=True also writes them to ROM.")
+      .def(
+          "servos",
+          [](board& b) {
+            std::vector<rcb4::robot::joint_reading> rs;
+            {
+              py::gil_scoped_release release;
+              rs = b.states();
+            }
+            py::dict d;
+            for (const auto& r : rs)
+              if (r.allocated)
+                d[py::int_(r.j->ics.value())] =
+                    py::dict("joint"_a = r.j->name, "position"_a = r.position, "target"_a = r.target, "trim"_a = r.trim,
+                             "answered"_a = r.answered());
+            return d;
+          },
+          "The joints' servo blocks by ICS number: joint, position (measured; 0: never answered), target (FREE "
+          "0x8000, HOLD 0x7FFF), trim (counts), answered.")
+      .def(
+          "scan",
+          [](board& b) {
+            std::vector<rcb4::ops::slot_probe> ps;
+            {
+              py::gil_scoped_release release;
+              ps = b.scan();
+            }
+            py::list out;
+            for (const auto& p : ps) {
+              const auto* j = b.robot().on(p.ics);
+              out.append(py::dict("ics"_a = p.ics.value(), "address"_a = p.address, "position"_a = p.position,
+                                  "answers"_a = p.answers(),
+                                  "joint"_a = j ? py::object(py::str(j->name)) : py::object(py::none())));
+            }
+            return out;
+          },
+          "The servo slots the board allocates, whether each answers, and the profile's joint on it.")
+      .def(
+          "control_loop", [](board& b) { return std::make_unique<control_loop>(b); }, py::keep_alive<0, 1>(),
+          "A control loop over every joint: planned reads, one CONST per write (see ControlLoop).");
+
+  py::class_<control_loop>(m, "ControlLoop", R"(The read and write halves of a control loop.
+
+    loop = board.control_loop()
+    while True:
+        q = loop.read()                 # numpy, degrees, in board.joint_names order (NaN: no answer)
+        loop.write(q + step, frames=1)  # one CONST of every target (NaN: keep that joint's target)
+
+The reads are planned once for the link; nothing is allocated per cycle in C++.)")
+      .def(
+          "read",
+          [](control_loop& l, std::optional<py::array_t<double, py::array::c_style>> out) {
+            py::array_t<double, py::array::c_style> a =
+                out ? *out : py::array_t<double, py::array::c_style>(static_cast<py::ssize_t>(l.size()));
+            if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != l.size())
+              throw board_error(fault::usage, "out: a float64 array of " + std::to_string(l.size()) + " values");
+            double* p = a.mutable_data();
+            {
+              py::gil_scoped_release release;
+              l.read(p);
+            }
+            return a;
+          },
+          "out"_a = py::none(), "Every joint's angle in degrees (into out when given: no new array).")
+      .def(
+          "write",
+          [](control_loop& l, const py::array_t<double, py::array::c_style | py::array::forcecast>& targets,
+             unsigned frames) {
+            if (targets.ndim() != 1 || static_cast<std::size_t>(targets.shape(0)) != l.size())
+              throw board_error(fault::usage,
+                                "targets: " + std::to_string(l.size()) + " degrees, in joint_names order");
+            if (const auto p = l.set(targets.data())) throw board_error(fault::limit, *p + " (nothing was sent)");
+            py::gil_scoped_release release;
+            l.send(frames);
+          },
+          "targets"_a, "frames"_a = 1,
+          "Sends every target (degrees; NaN keeps a joint's target) as one CONST reached in frames output periods; "
+          "a target beyond a limit raises LimitError and sends nothing.")
+      .def_property_readonly("size", &control_loop::size, "How many joints (the profile's).");
+
+  m.def(
+      "load_pose",
+      [](const py::object& path, const std::string& robot) {
+        const std::string p = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        try {
+          const auto model = rcb4::robot::open_profile(robot);
+          const auto pose = rcb4::robot::load_pose(p, model);
+          return py::dict("robot"_a = pose.robot, "joints"_a = joints_dict(pose.joints),
+                          "time"_a = pose.time ? py::object(py::float_(static_cast<double>(pose.time->count()) / 1000))
+                                               : py::object(py::none()));
+        } catch (const rcb4::robot::profile_error& e) {
+          throw board_error(fault::usage, e.what());
+        }
+      },
+      "path"_a, "robot"_a = "khr-3hv", "Reads a pose file (JSON or YAML, as rcb4 pose writes): robot, joints, time.");
+  m.def(
+      "save_pose",
+      [](const py::object& path, const py::dict& joints, const std::string& robot, std::optional<double> time) {
+        const std::string p = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        try {
+          const auto model = rcb4::robot::open_profile(robot);
+          rcb4::robot::pose pose{model.name(), {}, std::nullopt};
+          for (const auto& [k, v] : joints) {
+            const auto name = k.cast<std::string>();
+            if (!model.find(name))
+              throw board_error(fault::usage, "no joint of " + model.name() + " is called '" + name + "'");
+            pose.joints.emplace_back(name, v.cast<double>());
+          }
+          if (time) pose.time = std::chrono::milliseconds(std::llround(*time * 1000));
+          rcb4::robot::save_pose(p, pose);
+        } catch (const rcb4::robot::profile_error& e) {
+          throw board_error(fault::usage, e.what());
+        }
+      },
+      "path"_a, "joints"_a, "robot"_a = "khr-3hv", "time"_a = py::none(),
+      "Writes a pose file (.json, .yaml or .yml) that rcb4 pose play and Board.play read.");
+}
+
+}  // namespace pyrcb4

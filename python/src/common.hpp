@@ -1,0 +1,60 @@
+// pyrcb4: what the binding files share (module.cpp: the Board; bind_robot.cpp: poses, trims,
+// scan, the control loop).
+// SPDX-License-Identifier: BSL-1.0
+#pragma once
+
+#include "board.hpp"
+
+#include <pybind11/pybind11.h>
+
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace pyrcb4 {
+namespace py = pybind11;
+
+/** Raises KeyboardInterrupt (or what a signal handler raised) when a signal came: call with the GIL. */
+inline void check_signals() {
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+}
+
+/** Sleeps @p seconds with the GIL released, looking at signals every 50 ms. */
+inline void sleep_interruptible(double seconds) {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                            std::chrono::duration<double>(seconds));
+  for (;;) {
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= until) return;
+    {
+      py::gil_scoped_release release;
+      std::this_thread::sleep_for(
+          std::min<std::chrono::steady_clock::duration>(until - now, std::chrono::milliseconds(50)));
+    }
+    check_signals();
+  }
+}
+
+/** Names from *args: strings, or lists/tuples of them (free("left_arm", "head"), free(["legs"])). */
+inline std::vector<std::string> names_of(const py::args& args) {
+  std::vector<std::string> out;
+  for (const auto& a : args) {
+    if (py::isinstance<py::str>(a)) {
+      out.push_back(a.cast<std::string>());
+    } else if (py::isinstance<py::list>(a) || py::isinstance<py::tuple>(a)) {
+      for (const auto& x : a) {
+        if (!py::isinstance<py::str>(x)) throw board_error(fault::usage, "joint and group names are strings");
+        out.push_back(x.cast<std::string>());
+      }
+    } else {
+      throw board_error(fault::usage, "joint and group names are strings");
+    }
+  }
+  return out;
+}
+
+/** Adds poses, trims, scan and the control loop to Board (bind_robot.cpp). */
+void bind_robot(py::module_& m, py::class_<board>& cls);
+
+}  // namespace pyrcb4
