@@ -17,7 +17,7 @@ packages=(
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
-  pybind11-dev python3-dev python3-pytest python3-numpy  # pyrcb4, the Python module, and its tests
+  pybind11-dev python3-dev python3-pytest python3-numpy python3-serial  # pyrcb4, its tests, its benchmark
 )
 
 missing=()

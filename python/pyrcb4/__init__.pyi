@@ -1,6 +1,6 @@
 # Type stubs for pyrcb4 (the _core extension): editors complete and type checkers check these.
 from os import PathLike
-from typing import Any, Dict, List, Optional, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy
 import numpy.typing
@@ -58,6 +58,10 @@ class Board:
 class ControlLoop:
     @property
     def size(self) -> int: ...
+    @property
+    def plan(self) -> List[Tuple[int, int]]: ...
+    @property
+    def slots(self) -> List[int]: ...
     def read(self, out: Optional[numpy.typing.NDArray[numpy.float64]] = None) -> numpy.typing.NDArray[numpy.float64]: ...
     def write(self, targets: numpy.typing.ArrayLike, frames: int = 1) -> None: ...
 

@@ -182,7 +182,16 @@ The reads are planned once for the link; nothing is allocated per cycle in C++.)
           "targets"_a, "frames"_a = 1,
           "Sends every target (degrees; NaN keeps a joint's target) as one CONST reached in frames output periods; "
           "a target beyond a limit raises LimitError and sends nothing.")
-      .def_property_readonly("size", &control_loop::size, "How many joints (the profile's).");
+      .def_property_readonly("size", &control_loop::size, "How many joints (the profile's).")
+      .def_property_readonly(
+          "plan",
+          [](const control_loop& l) {
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> out;
+            for (const auto& r : l.plan()) out.emplace_back(r.address, r.size);
+            return out;
+          },
+          "The RAM reads the planner chose for this link: (address, size) each.")
+      .def_property_readonly("slots", &control_loop::slots, "The ICS numbers a write sends, ascending.");
 
   m.def(
       "load_pose",

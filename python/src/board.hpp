@@ -163,6 +163,14 @@ class control_loop {
   std::optional<std::string> set(const double* degrees);
   /** Sends every target as one CONST, reached in @p frames output periods. */
   void send(unsigned frames);
+  /** The reads the planner chose: (address, size) of each. */
+  const std::vector<rcb4::ops::byte_range>& plan() const noexcept { return reads_.plan(); }
+  /** The ICS numbers a write sends, ascending. */
+  std::vector<unsigned> slots() const {
+    std::vector<unsigned> out;
+    for (const auto ics : targets_.targets().mask()) out.push_back(ics.value());
+    return out;
+  }
 
  private:
   board& b_;

@@ -15,7 +15,7 @@ servo_set<servo_position> knee(int position) {
   return s;
 }
 template <class T>
-const T& as(const action& a) {
+T as(const action& a) {
   REQUIRE(std::holds_alternative<T>(a));
   return std::get<T>(a);
 }
@@ -28,7 +28,7 @@ TEST_CASE("player: poses as CONST frames with their frames to wait, a loop count
   player p(knee_bends);
   REQUIRE(p.error().empty());
   for (int i = 0; i < 3; ++i) {
-    const auto& s = as<send>(p.next());
+    const auto s = as<send>(p.next());
     CHECK(s.frames == 20);
     // protocol.md §5 by hand: ICS 16, flags set, 20 frames, 8389 = 0x20C5.
     const auto f = encode(s.cmd);
@@ -36,7 +36,7 @@ TEST_CASE("player: poses as CONST frames with their frames to wait, a loop count
           std::vector<std::uint8_t>{0x0B, 0x10, 0x00, 0x00, 0x01, 0x00, 0x00, 0x14, 0xC5, 0x20, 0x15});
   }
   // The button test reads the button word from the board.
-  const auto& r = as<read_value>(p.next());
+  const auto r = as<read_value>(p.next());
   CHECK(r.address.value() == 0x0350);
   CHECK(r.size == 2);
   p.value(0x0000);  // nothing pressed: on to the end
@@ -66,11 +66,11 @@ TEST_CASE("player: a test of the counter compares the player's value, any other 
   player p(prog);
   REQUIRE(p.error().empty());
   // 2 - 1 = 1: not zero, no exit; equal to 1: to 'one'; the stretch frame, with no wait.
-  const auto& s = as<send>(p.next());
+  const auto s = as<send>(p.next());
   CHECK(s.frames == 0);
   CHECK(std::holds_alternative<servo_params>(s.cmd));
   // 0x0460 is no counter of the player: read from the board. 7 is not below 5: on to 'out'.
-  const auto& r = as<read_value>(p.next());
+  const auto r = as<read_value>(p.next());
   CHECK(r.address.value() == 0x0460);
   CHECK(r.size == 1);
   p.value(0x1107);  // a 1-byte value: the high byte is not part of it
