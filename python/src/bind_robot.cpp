@@ -142,6 +142,76 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
           },
           "The servo slots the board allocates, whether each answers, and the profile's joint on it.")
       .def(
+          "move_servos",
+          [](board& b, const py::dict& targets, unsigned frames) {
+            rcb4::servo_set<rcb4::servo_position> set;
+            for (const auto& [k, v] : targets) {
+              const auto ics = rcb4::ics_number::make(k.cast<unsigned>());
+              if (!ics) throw board_error(fault::usage, "move_servos: an ICS number is 0..35");
+              if (set.contains(*ics)) throw board_error(fault::usage, "move_servos: ICS given twice");
+              std::optional<rcb4::servo_position> p;
+              if (py::isinstance<py::str>(v)) {
+                const auto w = v.cast<std::string>();
+                if (w == "free") p = rcb4::servo_position::free();
+                if (w == "hold") p = rcb4::servo_position::hold();
+              } else if (py::isinstance<py::int_>(v)) {
+                const auto r = rcb4::servo_position::make(v.cast<int>());
+                if (r) p = *r;
+              }
+              if (!p) throw board_error(fault::usage, "move_servos: a position is 0..16383, 'free' or 'hold'");
+              set.insert(*ics, *p);
+            }
+            py::gil_scoped_release release;
+            b.move_servos(set, frames);
+          },
+          "targets"_a, "frames"_a = 1,
+          "Servos by ICS number {ics: position} (0..16383, 'free', 'hold') in one CONST over frames output periods.")
+      .def(
+          "set_config",
+          [](board& b, const py::kwargs& fields) {
+            rcb4::config_word c;
+            {
+              py::gil_scoped_release release;
+              c = b.config();
+            }
+            for (const auto& [k, v] : fields) {
+              const auto key = k.cast<std::string>();
+              const auto flag = [&](bool& f) {
+                if (!py::isinstance<py::bool_>(v)) throw board_error(fault::usage, key + ": True or False");
+                f = v.cast<bool>();
+              };
+              if (key == "ics")
+                flag(c.ics_enabled);
+              else if (key == "program")
+                flag(c.rom_program);
+              else if (key == "interp_message")
+                flag(c.interpolation_message);
+              else if (key == "vector_jump")
+                flag(c.vector_jump);
+              else if (key == "led")
+                flag(c.led);
+              else if (key == "period_ms") {
+                const auto ms = v.cast<int>();
+                if (ms != 10 && ms != 15 && ms != 20 && ms != 25)
+                  throw board_error(fault::usage, "period_ms: 10, 15, 20 or 25");
+                c.period = static_cast<rcb4::output_period>((ms - 10) / 5);
+              } else if (key == "ics_baud") {
+                const auto code = rcb4::baud_code_of(v.cast<std::uint32_t>());
+                if (!code) throw board_error(fault::usage, "ics_baud: 115200, 625000 or 1250000");
+                c.ics_baud = *code;
+              } else {
+                throw board_error(fault::usage, "set_config: '" + key +
+                                                    "' is not a field it writes (ics, program, interp_message, "
+                                                    "vector_jump, period_ms, ics_baud, led; the COM baud: rcb4 config "
+                                                    "set baud=)");
+              }
+            }
+            py::gil_scoped_release release;
+            b.set_config(c);
+          },
+          "Changes config fields (RAM: power-off restores): ics, program, interp_message, vector_jump, led (bool), "
+          "period_ms (10/15/20/25), ics_baud.")
+      .def(
           "control_loop", [](board& b) { return std::make_unique<control_loop>(b); }, py::keep_alive<0, 1>(),
           "A control loop over every joint: planned reads, one CONST per write (see ControlLoop).");
 

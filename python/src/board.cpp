@@ -319,6 +319,22 @@ std::vector<rcb4::ops::slot_probe> board::scan() {
   return run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))), "scan");
 }
 
+void board::move_servos(const rcb4::servo_set<rcb4::servo_position>& targets, unsigned frames) {
+  const auto f = rcb4::frames::make(frames);
+  if (!f) throw board_error(fault::usage, "frames: 0..255");
+  const auto frame = rcb4::const_servo::make(targets, *f);
+  if (!frame) throw board_error(fault::usage, "move_servos: " + std::string(rcb4::message(frame.error())));
+  // The board ignores a servo it has no block for: said, not silently dropped.
+  const auto slots = run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))), "scan");
+  for (const auto ics : targets.mask())
+    if (std::none_of(slots.begin(), slots.end(), [&](const auto& p) { return p.ics == ics; }))
+      throw board_error(fault::refused, "ICS " + std::to_string(ics.value()) + " has no servo block on the board");
+  std::shared_lock life(life_);
+  t::error_code ec;
+  c("move_servos").execute(rcb4::command{*frame}, ec);
+  if (ec) raise(ec, "move_servos");
+}
+
 // --- control loop ------------------------------------------------------------------------------
 
 control_loop::control_loop(board& b)

@@ -122,6 +122,8 @@ class board {
   void set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent);
   /** The allocated servo slots, with their measured positions. */
   std::vector<rcb4::ops::slot_probe> scan();
+  /** Sends servos by ICS number to positions (FREE, HOLD or 0..16383) over @p frames, in one CONST. */
+  void move_servos(const rcb4::servo_set<rcb4::servo_position>& targets, unsigned frames);
 
  private:
   template <class Op>

@@ -30,8 +30,18 @@ def served(rcb4_tool):
         srv.wait(timeout=10)
 
 
-@pytest.fixture
-def board():
+@pytest.fixture(params=["in-process", "served"])
+def board(request, rcb4_tool):
+    """Every API test runs twice: on the in-process virtual board, and on `rcb4 serve --pty` by its path."""
     import pyrcb4
-    with pyrcb4.Board() as b:
-        yield b
+    if request.param == "in-process":
+        with pyrcb4.Board() as b:
+            yield b
+        return
+    srv = subprocess.Popen([rcb4_tool, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+    try:
+        with pyrcb4.Board(srv.stdout.readline().strip()) as b:
+            yield b
+    finally:
+        srv.terminate()
+        srv.wait(timeout=10)

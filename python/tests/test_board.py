@@ -133,6 +133,8 @@ def test_bad_boards_raise_before_their_timeout():
         pyrcb4.Board(StandIn(mode="nack").path, baud=115200)
     with pytest.raises(pyrcb4.BadReply):
         pyrcb4.Board(StandIn(mode="badsum").path, baud=115200)
+    with pytest.raises(pyrcb4.BadReply):
+        pyrcb4.Board(StandIn(mode="short").path, baud=115200).read(0x0000, 2)
     b = pyrcb4.Board(StandIn(mode="die", die_after=3).path, baud=115200)
     with pytest.raises((pyrcb4.Timeout, pyrcb4.DeviceError)):
         for _ in range(10):
@@ -234,3 +236,23 @@ def test_control_loop(board):
     assert abs(loop.read()[k] - 25) < 0.1  # nothing was sent
     with pytest.raises(pyrcb4.UsageError):
         loop.write(numpy.zeros(3))
+
+
+def test_config_fields_and_servos_by_ics(board):
+    board.set_config(led=True, period_ms=15)
+    c = board.config
+    assert c["led"] and c["period_ms"] == 15
+    with pytest.raises(pyrcb4.UsageError, match="not a field it writes"):
+        board.set_config(baud=625000)
+    with pytest.raises(pyrcb4.UsageError, match="10, 15, 20 or 25"):
+        board.set_config(period_ms=12)
+    board.set_config(period_ms=10)
+    board.move_servos({16: 8389, 0: "hold"}, frames=1)
+    time.sleep(0.05)
+    assert board.servos()[16]["position"] == 8389 and abs(board.joints()["left_knee"] - 30) < 0.1
+    board.move_servos({16: "free"})
+    assert board.servos()[16]["target"] == 0x8000
+    with pytest.raises(pyrcb4.BoardRefused, match="ICS 30 has no servo block"):
+        board.move_servos({30: 7500})
+    with pytest.raises(pyrcb4.UsageError):
+        board.move_servos({16: 20000})
