@@ -315,10 +315,13 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
               py::gil_scoped_release release;
               s = b.sensors();
             }
-            return py::dict("battery_volts"_a = s.battery_volts, "ad"_a = s.ad, "pio_direction"_a = s.pio_direction,
-                            "pio_value"_a = s.pio_value, "buttons"_a = s.buttons, "button_names"_a = s.button_names,
-                            "pa"_a = s.pa);
+            std::vector<double> volts;
+            for (const auto v : s.ad) volts.push_back(std::round(v * 5.0 / 1024 * 1000) / 1000);
+            return py::dict("battery_volts"_a = s.battery_volts, "ad"_a = s.ad, "ad_volts"_a = volts,
+                            "pio_direction"_a = s.pio_direction, "pio_value"_a = s.pio_value, "buttons"_a = s.buttons,
+                            "button_names"_a = s.button_names, "pa"_a = s.pa);
           },
-          "AD0..AD10, battery volts, PIO, KRR buttons and PA1..PA4.");
+          "battery_volts, ad (AD0..AD10 as read), ad_volts (each x 5 V / 1024: the 10-bit 0-5 V input; AD0 is the "
+          "supply divided by 5), pio_direction, pio_value, buttons, button_names, pa (PA1..PA4).");
   bind_robot(m, cls);
 }

@@ -93,6 +93,9 @@ def test_motions(board):
 def test_sensors(board):
     s = board.sensors()
     assert 5 < s["battery_volts"] < 20 and len(s["ad"]) == 11 and s["button_names"] == [] and len(s["pa"]) == 4
+    assert abs(s["ad_volts"][0] * 5 - s["battery_volts"]) < 0.02  # AD0 is the supply / 5 (protocol.md §6)
+    board.write(0x0350, b"\x02\x01")  # UP + S1 as a KRR receiver leaves them (protocol.md §6: 02 01)
+    assert board.sensors()["button_names"] == ["up", "s1"]
 
 
 def test_closed_board_and_context_manager():
