@@ -312,7 +312,7 @@ std::string step_yaml(const motion_step& s) {
           if (x.address == motion::button_word && x.size == 2 &&
               (x.how == motion::compare::equal || x.how == motion::compare::not_equal))
             return std::string(x.how == motion::compare::equal ? "- if_buttons: " : "- unless_buttons: ") +
-                   yaml_quoted(motion::buttons_text(x.value)) + "\n  goto: " + key_text(x.to) + "\n";
+                   yaml_quoted(motion::buttons_text(x.buttons_of())) + "\n  goto: " + key_text(x.to) + "\n";
           return "- if_ram: " + hex(x.address.value(), 4) + "\n  size: " + std::to_string(x.size) + "\n  " +
                  std::string(compares[static_cast<std::size_t>(x.how)]) + ": " +
                  (x.size == 1 ? std::to_string(x.value) : hex(x.value, 4)) + "\n  goto: " + key_text(x.to) + "\n";

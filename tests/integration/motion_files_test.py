@@ -32,6 +32,11 @@ def write(name, text):
         f.write(text)
 
 
+def joints_deg(on):
+    rc, out, err = run("--json", *on, "joint", "list")
+    return {x["name"]: x["degrees"] for x in json.loads(out)} if rc == 0 else {}
+
+
 def rom(on, address, n):
     rc, out, err = run("--json", *on, "read", "rom", hex(address), str(n))
     return bytes(json.loads(out)["bytes"]) if rc == 0 else b""
@@ -57,7 +62,7 @@ knee_at_5 = bytes.fromhex(
     "0B 10 00 00 01 00 00 14 C5 20 15"   # CONST ICS 16 = 8389 (+30 deg), 20 frames, flags set
     "08 07 02 57 04 00 01 6D"            # SUB 1 from 0x0457
     "07 0B 88 2B 00 04 C9"               # JUMP 0x002B88 when Z = 0
-    "09 07 82 50 03 00 01 00 E6"         # SUB S 0x0001 (UP) from 0x0350
+    "09 07 82 50 03 00 00 01 E6"         # SUB S of 0x0350 with UP as it lies there: 00 01 (§6)
     "07 0B 88 2B 00 05 CA"               # JUMP 0x002B88 when Z = 1
     "03 0D 10")                          # RETURN
 
@@ -181,6 +186,23 @@ with serve("--rom", rom_file, "--period", "15") as dev:
                         "  - call: 1\n  - end\n")
     rc, out, err = run(*on, "motion", "play", "calls.yaml")
     check(rc == 0 and "1 pose, 1 ROM motion in" in out, f"a file that calls ROM motion 1 ({rc}: {out.strip()!r} {err.strip()!r})")
+    # A button test sees the buttons as a receiver leaves them (0x0350 high byte first, protocol.md
+    # §6): TRIANGLE (0x0010) is 00 10 there; SQUARE (0x0100), 01 00, is another button. From the
+    # host and from ROM.
+    write("branch.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - if_buttons: triangle\n    goto: yes\n"
+                         "  - pose: {head_yaw: 10}\n    time_ms: 150\n  - end\n  - label: yes\n"
+                         "  - pose: {head_yaw: -10}\n    time_ms: 150\n  - end\n")
+    run(*on, "motion", "push", "branch.yaml", "8", "--backup", "eight.bin")
+    for held, want in (("00 10", -10), ("01 00", 10)):
+        run(*on, "write", "ram", "0x0350", held)
+        rc1, _, err1 = run(*on, "motion", "play", "branch.yaml")
+        host = joints_deg(on)["head_yaw"]
+        run(*on, "joint", "move", "head_yaw=0@15")
+        rc2, _, err2 = run(*on, "motion", "play", "8", "--wait", "--timeout", "5")
+        rom_played = joints_deg(on)["head_yaw"]
+        check(rc1 == 0 and rc2 == 0 and abs(host - want) < 0.1 and abs(rom_played - want) < 0.1,
+              f"if_buttons triangle with {held} at 0x0350: head_yaw {want:+} from the host and from ROM ({host}, {rom_played}; {err1.strip()!r} {err2.strip()!r})")
+    run(*on, "write", "ram", "0x0350", "00 00")
     write("unslotted.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {\"ics 30\": 7500}\n    time_ms: 150\n  - end\n")
     rc, out, err = run(*on, "motion", "play", "unslotted.yaml")
     check(rc == 1 and "(ICS 30) has no slot on the board" in err, f"a servo without a slot: exit 1, nothing sent ({rc}: {err.strip()!r})")

@@ -50,7 +50,7 @@ TEST_CASE("player: a held button goes round again, and the counter wraps as the 
   player p(knee_bends);
   for (int i = 0; i < 3; ++i) as<send>(p.next());
   as<read_value>(p.next());
-  p.value(0x0001);  // UP held: back to 'again'
+  p.value(0x0100);  // UP held (00 01 at 0x0350, read low byte first): back to 'again'
   as<send>(p.next());
   // The counter was 0: SUB 1 makes 255, not 0, so the loop goes on as it would on the board.
   as<send>(p.next());

@@ -82,10 +82,21 @@ struct branch_if {
   std::uint16_t value = 0;            ///< the literal
   compare how = compare::equal;       ///< the test
   std::string to;                     ///< a label
-  /** A jump when the KRR button word is (or, with @p equal false, is not) @p buttons. */
+  /**
+   * A jump when the KRR button word is (or, with @p equal false, is not) @p buttons. The receiver
+   * leaves the word high byte first at 0x0350 (krr::encode_buttons, protocol.md §6) and a 2-byte
+   * SUB reads RAM low byte first, so the literal is the word with its bytes swapped: UP (0x0001)
+   * lies as 00 01 and compares with the literal 0x0100.
+   */
   static branch_if buttons(std::uint16_t buttons, std::string to, bool equal = true) {
-    return {button_word, 2, buttons, equal ? compare::equal : compare::not_equal, std::move(to)};
+    return {button_word, 2, as_ram_value(buttons), equal ? compare::equal : compare::not_equal, std::move(to)};
   }
+  /** The button word @p buttons as a 2-byte read of 0x0350 gives it (its bytes swapped). */
+  static constexpr std::uint16_t as_ram_value(std::uint16_t buttons) noexcept {
+    return static_cast<std::uint16_t>((buttons >> 8) | ((buttons & 0xFFu) << 8));
+  }
+  /** The buttons of a branch on the button word (buttons() undone). */
+  std::uint16_t buttons_of() const noexcept { return as_ram_value(value); }
   friend bool operator==(const branch_if&, const branch_if&) = default;
 };
 /** An unconditional jump to a label. */
