@@ -222,7 +222,12 @@ struct motion_options {
 };
 /** Adds --layout (auto, 2.2, 2.0, 2.1, 1.3) to @p cmd. */
 void add_layout(CLI::App* cmd, motion_options& o);
-/** The layout --layout names; auto: told from the ROM (ops::detect_layout), else a failure naming why. */
+/** The layout --layout names (nothing for auto), before any board is asked. */
+const rcb4::rom_layout* named_layout(const motion_options& o);
+/**
+ * The layout --layout names, refused when the ROM plainly has another; auto: told from the ROM
+ * (ops::detect_layout), else a failure naming why.
+ */
 const rcb4::rom_layout& layout_for(session& s, const motion_options& o);
 /** `motion play FILE`: a motion file played from the host, pose by pose with the board's timing (cmd_motion_files.cpp).
  */

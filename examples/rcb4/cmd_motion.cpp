@@ -20,11 +20,25 @@ void add_layout(CLI::App* cmd, motion_options& o) {
       ->check(CLI::IsMember({"auto", "1.3", "2.0", "2.1", "2.2"}));
 }
 
+const rcb4::rom_layout* named_layout(const motion_options& o) {
+  if (o.layout == "1.3") return &rcb4::hth4_1_3;
+  if (o.layout == "2.0" || o.layout == "2.1") return &rcb4::hth4_2_0;
+  if (o.layout == "2.2") return &rcb4::hth4_2_2;
+  return nullptr;
+}
+
 const rcb4::rom_layout& layout_for(session& s, const motion_options& o) {
-  if (o.layout == "1.3") return rcb4::hth4_1_3;
-  if (o.layout == "2.0" || o.layout == "2.1") return rcb4::hth4_2_0;
-  if (o.layout == "2.2") return rcb4::hth4_2_2;
   const auto guess = s.run(rcb4::ops::detect_layout{});
+  if (const auto* named = named_layout(o)) {
+    // Named, but the ROM says another: its slots would cut across the board's motions.
+    if (guess.layout && guess.layout != named)
+      throw failure(exit_board,
+                    fmt::format("--layout {} is another layout than this board's ROM has: {} ({}); its slots would "
+                                "cut across the board's motions",
+                                o.layout, guess.layout->name, guess.reason),
+                    "leave --layout out (auto), or name the board's own");
+    return *named;
+  }
   if (!guess.layout)
     throw failure(exit_board,
                   fmt::format("cannot tell which HeartToHeart4 layout the board's ROM has: {}", guess.reason),
@@ -140,6 +154,8 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
 /** `motion show N`: the slot's code as the board runs it, poses in the robot's joints. */
 int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   namespace m = rcb4::motion;
+  if (const auto* named = named_layout(o); named && !m::slot_of(*named, static_cast<unsigned>(n)))
+    throw usage_error(fmt::format("motion {}: the {} layout has motions 1-{}", n, named->name, named->motion_count));
   const auto& layout = layout_for(s, o);
   const auto where = m::slot_of(layout, static_cast<unsigned>(n));
   if (!where)

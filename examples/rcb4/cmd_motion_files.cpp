@@ -99,13 +99,20 @@ std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, uns
 }
 
 /** Refuses to write while the ROM program runs a motion (the board would fetch the bytes being replaced). */
-void require_idle(session& s, const rcb4::rom_layout& layout) {
+void require_idle(session& s, const rcb4::rom_layout& layout, unsigned n) {
   // A motion slot's code running (servos still moving after a host move set the update flags too: that is no program).
   const auto st = s.run(rcb4::ops::read_motion_state(layout));
   if (st.running && st.motion)
     throw failure(exit_board,
                   fmt::format("motion {} is running: the board would run the bytes being written", *st.motion),
                   "rcb4 motion wait, or rcb4 motion stop, then write");
+  // Stopped part way in this slot: motion resume would continue in the middle of the new bytes.
+  if (st.suspended && st.motion && *st.motion == n)
+    throw failure(exit_board,
+                  fmt::format("motion {} is stopped part way (program counter 0x{:06X}): motion resume would continue "
+                              "in the middle of the bytes being written",
+                              n, st.program_counter),
+                  "rcb4 motion play N (any motion) starts the program afresh; then write");
 }
 
 /** Warns when a remote button plays motion @p n (erased or changed, a press plays what is there now). */
@@ -114,17 +121,26 @@ void warn_buttons(session& s, const mo::slot& where, unsigned n, std::string_vie
   if (!b.empty() && !g.json) fmt::print(stderr, "note: {} plays motion {}: {}\n", fmt::join(b, ", "), n, what);
 }
 
-/** Refuses a program that calls an empty slot: the board's program would stop there (program-error). */
-void check_callees(session& s, const mo::program& p, const mo::slot& where) {
+/**
+ * Refuses a program that calls an empty slot: the board's program would stop there (program-error).
+ * @p where_ is each step's "FILE:LINE", @p done what did not happen ("written", "sent").
+ */
+void check_callees(session& s, const mo::program& p, const mo::slot& where, const rcb4::rom_layout& layout,
+                   const std::vector<std::string>& where_, std::string_view done) {
   for (std::size_t i = 0; i < p.steps.size(); ++i)
     if (const auto* c = std::get_if<mo::call_motion>(&p.steps[i]); c && c->address != where.address) {
       const auto first = s.run(rcb4::ops::read_memory(memory::rom, c->address.value(), 128));
-      if (!rcb4::ops::detail::holds_frame(first))
-        throw failure(exit_board,
-                      fmt::format("step {} calls 0x{:06X}, which holds no motion: the board's program would stop "
-                                  "there (nothing was written)",
-                                  i + 1, c->address.value()),
-                      "push that motion first; rcb4 motion list shows the used slots");
+      if (rcb4::ops::detail::holds_frame(first)) continue;
+      const std::uint32_t a = c->address.value(), base = layout.motion_base.value();
+      const bool slot = a >= base && (a - base) % layout.slot_size == 0;
+      throw failure(exit_board,
+                    fmt::format("step {}{} calls {}, which holds no motion: the board's program would stop there "
+                                "(nothing was {})",
+                                i + 1, i < where_.size() ? fmt::format(" ({})", where_[i]) : std::string(),
+                                slot ? fmt::format("motion {} (0x{:06X})", (a - base) / layout.slot_size + 1, a)
+                                     : fmt::format("0x{:06X}", a),
+                                done),
+                    "push that motion first; rcb4 motion list shows the used slots");
     }
 }
 
@@ -238,7 +254,7 @@ std::vector<std::uint8_t> bytes_of(session& s, const push_options& o, const rcb4
   if (!ro::ok(c))
     throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<ro::problem>(c).message));
   const auto& cm = std::get<ro::compiled_motion>(c);
-  check_callees(s, cm.program, where);
+  check_callees(s, cm.program, where, layout, d.where, "written");
   notes = cm.notes;
   const auto b = mo::assemble(cm.program, where);
   if (!mo::ok(b))
@@ -274,7 +290,7 @@ int push(session& s, const push_options& o, const globals& g) {
                  where.address.value(), layout.name, summary, rcb4::hex_view{bytes});
     return exit_ok;
   }
-  require_idle(s, layout);
+  require_idle(s, layout, n);
   const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
   if (std::equal(bytes.begin(), bytes.end(), old.begin())) {
     if (g.json)
@@ -308,7 +324,7 @@ int erase(session& s, const push_options& o, const globals& g) {
   const auto& layout = layout_for(s, o.m);
   const auto where = slot_for(layout, o.n);
   const auto n = static_cast<unsigned>(o.n);
-  require_idle(s, layout);
+  require_idle(s, layout, n);
   const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
   if (std::all_of(old.begin(), old.end(), [](std::uint8_t b) { return b == 0xFF; })) {
     if (g.json)
@@ -386,7 +402,7 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
                                     j ? j->name : "a servo", e.ics.value()),
                         "rcb4 scan shows the board's slots");
         }
-  check_callees(s, cm.program, mo::slot{rcb4::rom_address{}, 0});
+  check_callees(s, cm.program, mo::slot{rcb4::rom_address{}, 0}, layout, d.where, "sent");
   mo::player pl(cm.program);
   if (!pl.error().empty()) throw usage_error(fmt::format("{}: {}", file, pl.error()));
   const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period));
@@ -420,10 +436,27 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
                                   "only whole motions are played",
                                   file, pl.step(), k->address.value(), layout.name));
       s.run(rcb4::ops::play_motion(*n, layout));
-      rcb4::transport::error_code ec;
-      rcb4::transport::wait_motion(s.c(), std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)), ec, {},
-                                   layout);
-      if (ec) throw rcb4::transport::system_error(ec);
+      // Its end, polled as the board refreshes the state (50 ms), Ctrl-C and --timeout looked at
+      // between polls: either stops the motion on the board too.
+      const auto until =
+          std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000));
+      for (;;) {
+        const auto st = s.run(rcb4::ops::read_motion_state(layout));
+        if (!st.running) break;
+        if (std::chrono::steady_clock::now() >= until) {
+          s.run(rcb4::ops::stop_motion{});
+          throw failure(exit_timeout,
+                        fmt::format("{}: motion {}, called at step {}, still ran after {:g} s: stopped", file, *n,
+                                    pl.step(), o.timeout_s),
+                        "a motion that loops for ever ends only when it is stopped; --wait --timeout S waits longer");
+        }
+        if (!wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(50))) {
+          s.run(rcb4::ops::stop_motion{});
+          stopped = true;
+          break;
+        }
+      }
+      if (stopped) break;
       ready = std::chrono::steady_clock::now();
     }
   }
@@ -435,8 +468,10 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
     if (g.json)
       emit(json{{"played", file}, {"interrupted", true}, {"poses", pl.poses()}, {"seconds", seconds()}});
     else
-      fmt::print(stderr, "interrupted at step {} after {} ({:.1f} s): the servos stay where the last pose took them\n",
-                 pl.step(), plural(pl.poses(), "pose"), seconds());
+      fmt::print(stderr,
+                 "interrupted at step {} after {} ({:.1f} s): the servos stay where the last pose took them{}\n",
+                 pl.step(), plural(pl.poses(), "pose"), seconds(),
+                 pl.calls() ? " (a ROM motion it called was stopped: rcb4 motion play N starts afresh)" : "");
     return exit_interrupted;
   }
   if (g.json)

@@ -11,7 +11,9 @@
 #include <unistd.h>
 
 #include <cstring>
+#include <exception>
 #include <filesystem>
+#include <fstream>
 #include <thread>
 
 namespace cli {
@@ -42,6 +44,16 @@ bool enter_within(std::chrono::milliseconds wait) {
 }
 
 int record(session& s, const record_options& o, const globals& g) {
+  // The file must be writable before the robot goes limp and someone spends a minute moving it.
+  {
+    const bool existed = std::filesystem::exists(o.file);
+    std::ofstream probe(o.file, std::ios::app);
+    if (!probe)
+      throw failure(exit_io, fmt::format("{}: cannot be written ({}): nothing recorded", o.file, std::strerror(errno)),
+                    "name a file in a folder you can write to");
+    probe.close();
+    if (!existed) std::filesystem::remove(o.file);
+  }
   const auto& m = robot_of(g);
   const auto js = joints_of(m, o.joints);
   const auto map = locate(s, m, js);
@@ -92,6 +104,7 @@ int record(session& s, const record_options& o, const globals& g) {
   const auto start = std::chrono::steady_clock::now();
   const auto every = std::chrono::milliseconds(o.every_ms);
   const bool tty = ::isatty(STDERR_FILENO) && !g.json;
+  std::exception_ptr lost;
   for (auto next = start;;) {
     const auto now = std::chrono::steady_clock::now();
     rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(now - start), sample);
@@ -104,13 +117,21 @@ int record(session& s, const record_options& o, const globals& g) {
     if (signal_catcher::caught() || enter_within(std::max(wait, std::chrono::milliseconds(0))) ||
         signal_catcher::caught())
       break;
-    angles(sample);
+    try {
+      angles(sample);
+    } catch (...) {  // the board went away: what was recorded is kept, then the failure is reported
+      lost = std::current_exception();
+      break;
+    }
   }
   rec.finish();
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  guard.on = false;
-  if (o.free) s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
+  // A lost board: the guard still tries to hold the joints on the way out, and fails quietly.
+  if (o.free && !lost) {
+    guard.on = false;
+    s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
+  }
   ro::motion_document d;
   d.robot = m.name();
   d.period = period;
@@ -129,6 +150,11 @@ int record(session& s, const record_options& o, const globals& g) {
                                 rec.samples(), o.every_ms, seconds, o.threshold, rec.poses().front().time.count()));
   } catch (const ro::profile_error& e) {
     throw failure(exit_io, e.what());
+  }
+  if (lost) {
+    fmt::print(stderr, "rcb4 motion record: the {} recorded before the board stopped answering are in {}\n",
+               plural(rec.poses().size(), "pose"), o.file);
+    std::rethrow_exception(lost);
   }
   if (rec.clamped() && !g.json)
     fmt::print(stderr, "note: {} angles were beyond a joint's limit and were recorded at the limit\n", rec.clamped());

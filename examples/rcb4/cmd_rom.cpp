@@ -111,6 +111,11 @@ int restore(session& s, const std::string& path, bool no_check, const globals& g
   if (const auto st = s.run(rcb4::ops::read_motion_state{}); st.running && st.motion)
     throw failure(exit_board, fmt::format("motion {} is running: the restore would rewrite what it runs", *st.motion),
                   "rcb4 motion wait, or rcb4 motion stop, then restore");
+  else if (st.suspended && st.motion)
+    throw failure(exit_board,
+                  fmt::format("motion {} is stopped part way: motion resume would continue in rewritten code",
+                              *st.motion),
+                  "rcb4 motion play N (any motion) starts the program afresh; then restore");
   const auto version = s.run(rcb4::ops::read_version{});
   const auto now = read_all(s, "reading ROM (the backup of what is replaced)", g);
   std::vector<std::size_t> differ;

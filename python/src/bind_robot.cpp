@@ -18,6 +18,12 @@ namespace {
 std::pair<std::vector<std::pair<std::string, double>>, std::optional<double>> pose_of(board& b,
                                                                                       const py::object& pose) {
   std::vector<std::pair<std::string, double>> joints;
+  // What load_pose returns: {"robot", "joints": {...}, "time"}.
+  if (py::isinstance<py::dict>(pose) && pose.contains("joints") && py::isinstance<py::dict>(pose["joints"])) {
+    auto inner = pose_of(b, pose["joints"]);
+    if (pose.contains("time") && !pose["time"].is_none()) inner.second = pose["time"].cast<double>();
+    return inner;
+  }
   if (py::isinstance<py::dict>(pose)) {
     for (const auto& [k, v] : pose.cast<py::dict>()) {
       if (!py::isinstance<py::str>(k)) throw board_error(fault::usage, "a pose's joint names are strings");
@@ -145,18 +151,31 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
           "move_servos",
           [](board& b, const py::dict& targets, unsigned frames) {
             rcb4::servo_set<rcb4::servo_position> set;
+            // Numbers as Python has them: int, numpy integers (anything with __index__).
+            const auto whole = [](const py::handle& h) -> std::optional<long long> {
+              if (py::isinstance<py::str>(h) || py::isinstance<py::float_>(h) || py::isinstance<py::bool_>(h))
+                return std::nullopt;
+              try {
+                return py::int_(py::reinterpret_borrow<py::object>(h)).cast<long long>();
+              } catch (const py::error_already_set&) {
+                return std::nullopt;
+              } catch (const py::cast_error&) {
+                return std::nullopt;
+              }
+            };
             for (const auto& [k, v] : targets) {
-              const auto ics = rcb4::ics_number::make(k.cast<unsigned>());
-              if (!ics) throw board_error(fault::usage, "move_servos: an ICS number is 0..35");
+              const auto key = whole(k);
+              if (!key || *key < 0 || *key > 35)
+                throw board_error(fault::usage, "move_servos: an ICS number is a whole number 0..35");
+              const auto ics = rcb4::ics_number::make(static_cast<unsigned>(*key));
               if (set.contains(*ics)) throw board_error(fault::usage, "move_servos: ICS given twice");
               std::optional<rcb4::servo_position> p;
               if (py::isinstance<py::str>(v)) {
                 const auto w = v.cast<std::string>();
                 if (w == "free") p = rcb4::servo_position::free();
                 if (w == "hold") p = rcb4::servo_position::hold();
-              } else if (py::isinstance<py::int_>(v)) {
-                const auto r = rcb4::servo_position::make(v.cast<int>());
-                if (r) p = *r;
+              } else if (const auto n = whole(v); n && *n >= 0 && *n <= 0x3FFF) {
+                p = rcb4::servo_position::make(static_cast<int>(*n)).value();
               }
               if (!p) throw board_error(fault::usage, "move_servos: a position is 0..16383, 'free' or 'hold'");
               set.insert(*ics, *p);
@@ -225,9 +244,21 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
 The reads are planned once for the link; nothing is allocated per cycle in C++.)")
       .def(
           "read",
-          [](control_loop& l, std::optional<py::array_t<double, py::array::c_style>> out) {
-            py::array_t<double, py::array::c_style> a =
-                out ? *out : py::array_t<double, py::array::c_style>(static_cast<py::ssize_t>(l.size()));
+          [](control_loop& l, const py::object& out) {
+            // out is filled in place: anything that would need a copy (another dtype, a strided view,
+            // a list) is refused rather than copied and left stale.
+            py::array_t<double, py::array::c_style> a;
+            if (out.is_none()) {
+              a = py::array_t<double, py::array::c_style>(static_cast<py::ssize_t>(l.size()));
+            } else {
+              const auto arr = py::isinstance<py::array>(out) ? py::reinterpret_borrow<py::array>(out) : py::array();
+              const bool fits = py::isinstance<py::array>(out) && arr.dtype().is(py::dtype::of<double>()) &&
+                                (arr.flags() & py::array::c_style) != 0 && arr.writeable();
+              if (!fits)
+                throw board_error(fault::usage, "out: a writable, contiguous float64 numpy array of " +
+                                                    std::to_string(l.size()) + " values");
+              a = py::reinterpret_borrow<py::array_t<double, py::array::c_style>>(out);
+            }
             if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != l.size())
               throw board_error(fault::usage, "out: a float64 array of " + std::to_string(l.size()) + " values");
             double* p = a.mutable_data();

@@ -22,8 +22,19 @@ namespace t = rcb4::transport;
 void raise(const std::error_code& ec, const std::string& what) {
   const std::string text = what.empty() ? ec.message() : what + ": " + ec.message();
   if (ec.category() == rcb4::codec_category()) {
-    if (ec == rcb4::errc::nack) throw board_error(fault::refused, text + " (the board answered NACK)");
-    throw board_error(fault::bad_reply, text);
+    using rcb4::errc;
+    if (ec == errc::nack) throw board_error(fault::refused, text + " (the board answered NACK)");
+    if (ec == errc::frames_out_of_range)
+      throw board_error(fault::limit, what +
+                                          ": longer than a move can take: 255 output periods of the board (2.55 s "
+                                          "at 10 ms, 6.375 s at 25 ms)");
+    // Malformed answers are BadReply; what the codec or an operation refused before or instead of
+    // sending (an empty motion slot, an allocation table with nothing in it) is the board lacking it.
+    static constexpr errc malformed[] = {errc::bad_checksum, errc::bad_reply_length, errc::echo_mismatch,
+                                         errc::bad_ack_code, errc::unexpected_ack};
+    for (const auto e : malformed)
+      if (ec == e) throw board_error(fault::bad_reply, text);
+    throw board_error(fault::refused, text);
   }
   if (ec == t::transport_errc::timeout || ec == t::transport_errc::no_board)
     throw board_error(
@@ -31,8 +42,12 @@ void raise(const std::error_code& ec, const std::string& what) {
         text + " (is the board powered, the cable in, the baud right? a slow link needs a longer timeout)");
   if (ec == t::transport_errc::truncated || ec == t::transport_errc::echo) throw board_error(fault::bad_reply, text);
   if (ec == std::errc::inappropriate_io_control_operation)
-    throw board_error(fault::device, what + ": not a serial port");
-  throw board_error(fault::device, text);
+    throw board_error(fault::device, what + ": not a serial port", ENOTTY);
+  // An OS error keeps its number (DeviceError.errno); others (a busy port, a lost link) have none.
+  const bool os = ec.category() == std::generic_category() || ec.category() == std::system_category() ||
+                  ec.category() == boost::system::generic_category() ||
+                  ec.category() == boost::system::system_category();
+  throw board_error(fault::device, text, os ? ec.value() : 0);
 }
 
 namespace {
@@ -123,6 +138,24 @@ client& board::c(const char* what) {
   return *client_;
 }
 
+rcb4::ops::link_cost board::link(const char* what) {
+  std::shared_lock life(life_);
+  return rcb4::ops::link_cost::at(c(what).options().baud, std::chrono::milliseconds(1));
+}
+
+void board::refuse_if_motion_runs(const char* what) {
+  // As the tool does: a ROM motion would overwrite the move a moment later.
+  std::shared_lock life(life_);
+  t::error_code ec;
+  rcb4::ops::read_motion_state op;
+  t::run(c(what), op, ec);
+  if (ec) raise(ec, what);
+  if (op.value().running && op.value().motion)
+    throw board_error(fault::refused, std::string(what) + ": motion " + std::to_string(*op.value().motion) +
+                                          " is running on the board: it would overwrite the move, so nothing was "
+                                          "sent (stop_motion() or wait_motion() first)");
+}
+
 template <class Op>
 auto board::run(Op op, const char* what) {
   std::shared_lock life(life_);
@@ -184,9 +217,8 @@ const rcb4::robot::joint_map& board::joints_located() {
 
 std::vector<std::optional<double>> board::angles() {
   const auto& map = joints_located();
-  const auto rs = run(rcb4::robot::read_joints(map, rcb4::robot::fields::positions,
-                                               rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))),
-                      "read the joints");
+  const auto rs =
+      run(rcb4::robot::read_joints(map, rcb4::robot::fields::positions, link("read the joints")), "read the joints");
   std::vector<std::optional<double>> out(model_.joints().size());
   for (const auto& r : rs)
     for (std::size_t i = 0; i < model_.joints().size(); ++i)
@@ -195,7 +227,10 @@ std::vector<std::optional<double>> board::angles() {
 }
 
 double board::move(const std::vector<std::pair<std::string, double>>& targets, double seconds) {
-  if (!(seconds >= 0) || seconds > 6.375) throw board_error(fault::usage, "time: 0 to 6.375 seconds");
+  if (!(seconds >= 0) || seconds > 6.375)
+    throw board_error(fault::limit,
+                      "time: a move takes 0 to 255 output periods of the board (2.55 s at 10 ms, "
+                      "6.375 s at 25 ms)");
   const auto time = std::chrono::milliseconds(static_cast<long long>(std::llround(seconds * 1000)));
   std::vector<rcb4::robot::joint_target> ts;
   for (const auto& [name, deg] : targets) {
@@ -205,6 +240,7 @@ double board::move(const std::vector<std::pair<std::string, double>>& targets, d
   }
   auto checked = rcb4::robot::check_targets(model_, ts, time);
   if (!rcb4::robot::ok(checked)) throw board_error(fault::limit, std::get<rcb4::robot::problem>(checked).message);
+  refuse_if_motion_runs("move");
   const auto moves = run(rcb4::robot::move_joints(std::get<std::vector<rcb4::robot::joint_move>>(checked)), "move");
   const auto period = config().period;
   unsigned longest = 0;
@@ -297,9 +333,7 @@ sensor_reading board::sensors() {
 
 std::vector<rcb4::robot::joint_reading> board::states() {
   const auto& map = joints_located();
-  return run(rcb4::robot::read_joints(map, rcb4::robot::fields::state,
-                                      rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))),
-             "read the joints");
+  return run(rcb4::robot::read_joints(map, rcb4::robot::fields::state, link("read the joints")), "read the joints");
 }
 
 void board::set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent) {
@@ -315,17 +349,16 @@ void board::set_trims(const std::vector<std::pair<std::string, double>>& trims, 
   run(rcb4::robot::write_trims(std::move(ts), persistent), "set the trims");
 }
 
-std::vector<rcb4::ops::slot_probe> board::scan() {
-  return run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))), "scan");
-}
+std::vector<rcb4::ops::slot_probe> board::scan() { return run(rcb4::ops::scan_slots(link("read the joints")), "scan"); }
 
 void board::move_servos(const rcb4::servo_set<rcb4::servo_position>& targets, unsigned frames) {
   const auto f = rcb4::frames::make(frames);
   if (!f) throw board_error(fault::usage, "frames: 0..255");
   const auto frame = rcb4::const_servo::make(targets, *f);
   if (!frame) throw board_error(fault::usage, "move_servos: " + std::string(rcb4::message(frame.error())));
+  refuse_if_motion_runs("move_servos");
   // The board ignores a servo it has no block for: said, not silently dropped.
-  const auto slots = run(rcb4::ops::scan_slots(rcb4::ops::link_cost::at(baud(), std::chrono::milliseconds(1))), "scan");
+  const auto slots = run(rcb4::ops::scan_slots(link("read the joints")), "scan");
   for (const auto ics : targets.mask())
     if (std::none_of(slots.begin(), slots.end(), [&](const auto& p) { return p.ics == ics; }))
       throw board_error(fault::refused, "ICS " + std::to_string(ics.value()) + " has no servo block on the board");
@@ -340,7 +373,7 @@ void board::move_servos(const rcb4::servo_set<rcb4::servo_position>& targets, un
 control_loop::control_loop(board& b)
     : b_(b),
       map_(b.joints_located()),
-      reads_(map_, rcb4::robot::fields::positions, rcb4::ops::link_cost::at(b.baud(), std::chrono::milliseconds(1))),
+      reads_(map_, rcb4::robot::fields::positions, b.link("control loop")),
       targets_(map_) {
   const auto js = targets_.joints();
   for (const auto& j : b.model_.joints()) {

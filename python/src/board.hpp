@@ -32,8 +32,9 @@ enum class fault { refused, timeout, device, bad_reply, limit, usage, closed };
 
 /** A failure with its kind and a message for a person. */
 struct board_error : std::runtime_error {
-  board_error(fault k, const std::string& what) : std::runtime_error(what), kind(k) {}
+  board_error(fault k, const std::string& what, int os_errno = 0) : std::runtime_error(what), kind(k), err(os_errno) {}
   fault kind;  ///< which exception
+  int err;     ///< the OS error number of a device error, or 0
 };
 
 /** How long a wait may go on before it checks for Ctrl-C (module.cpp passes PyErr_CheckSignals). */
@@ -129,6 +130,8 @@ class board {
   template <class Op>
   auto run(Op op, const char* what);
   client& c(const char* what);
+  rcb4::ops::link_cost link(const char* what);
+  void refuse_if_motion_runs(const char* what);
   const rcb4::rom_layout& layout();
   const rcb4::robot::joint_map& joints_located();
 

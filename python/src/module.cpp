@@ -104,7 +104,13 @@ PYBIND11_MODULE(_core, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const board_error& e) {
-      PyErr_SetString(class_of(e.kind), e.what());
+      if (e.kind == fault::device && e.err != 0) {
+        // An OSError with its errno and strerror, as open() raises one.
+        py::tuple args = py::make_tuple(e.err, std::string(e.what()));
+        PyErr_SetObject(class_of(e.kind), args.ptr());
+      } else {
+        PyErr_SetString(class_of(e.kind), e.what());
+      }
     }
   });
 
@@ -119,7 +125,12 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
   cls.def(py::init(&open_board), "device"_a = py::none(), "baud"_a = py::none(), "robot"_a = "khr-3hv",
           "timeout"_a = 0.1)
       .def(
-          "__enter__", [](board& b) -> board& { return b; }, py::return_value_policy::reference)
+          "__enter__",
+          [](board& b) -> board& {
+            if (!b.is_open()) throw board_error(fault::closed, "with: the board is closed");
+            return b;
+          },
+          py::return_value_policy::reference)
       .def("__exit__",
            [](board& b, const py::args&) {
              py::gil_scoped_release release;
@@ -150,7 +161,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "read",
           [](board& b, std::uint32_t address, std::size_t n, const std::string& memory) {
             std::vector<std::uint8_t> v;
-            {
+            if (n > 0) {
               py::gil_scoped_release release;
               v = b.read(memory, address, n);
             }
@@ -159,9 +170,13 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "address"_a, "n"_a, "memory"_a = "ram", "n bytes of RAM or ROM from address, as bytes.")
       .def(
           "write",
-          [](board& b, std::uint32_t address, const py::bytes& data, const std::string& memory) {
-            const std::string s = data;
-            const std::vector<std::uint8_t> v(s.begin(), s.end());
+          [](board& b, std::uint32_t address, const py::buffer& data, const std::string& memory) {
+            // Anything with the buffer protocol: bytes, bytearray, memoryview, a numpy uint8 array.
+            const py::buffer_info info = data.request();
+            if (info.itemsize != 1 || info.ndim > 1)
+              throw board_error(fault::usage, "write: data is bytes (or a 1-D buffer of bytes)");
+            const auto* p = static_cast<const std::uint8_t*>(info.ptr);
+            const std::vector<std::uint8_t> v(p, p + info.size);
             py::gil_scoped_release release;
             b.write(memory, address, v);
           },

@@ -259,3 +259,50 @@ def test_config_fields_and_servos_by_ics(board):
         board.move_servos({30: 7500})
     with pytest.raises(pyrcb4.UsageError):
         board.move_servos({16: 20000})
+
+
+def test_what_a_newcomer_found(board, tmp_path):
+    # No crash on a closed board, whatever is called.
+    b = pyrcb4.Board()
+    b.close()
+    for call in (b.scan, b.joints, b.servos, b.trims, b.capture, b.control_loop, b.version):
+        with pytest.raises(pyrcb4.UsageError, match="closed"):
+            call()
+    with pytest.raises(pyrcb4.UsageError, match="closed"):
+        with b:
+            pass
+    # read(out=...) fills the array given, or refuses: never a silent copy.
+    loop = board.control_loop()
+    for bad in (numpy.zeros(20, numpy.float32), numpy.zeros(40)[::2], [0.0] * 20):
+        with pytest.raises(pyrcb4.UsageError, match="contiguous float64"):
+            loop.read(out=bad)
+    # No move while a ROM motion runs (it would overwrite it); the reason is said.
+    board.play_motion(2, wait=False)
+    with pytest.raises(pyrcb4.BoardRefused, match="motion 2 is running"):
+        board.move({"left_knee": 10})
+    with pytest.raises(pyrcb4.BoardRefused, match="motion 2 is running"):
+        board.move_servos({16: 7600})
+    board.wait_motion()
+    # Too long a move is a limit, an empty slot the board lacking it.
+    with pytest.raises(pyrcb4.LimitError, match="255 output periods"):
+        board.move({"left_knee": 5}, time=3.0)
+    with pytest.raises(pyrcb4.BoardRefused, match="no program"):
+        board.play_motion(7)
+    # load_pose's result plays as it is; numpy integers are numbers; bytes-likes write.
+    pyrcb4.save_pose(tmp_path / "p.json", {"left_knee": 12}, time=0.1)
+    board.play(pyrcb4.load_pose(tmp_path / "p.json"))
+    assert abs(board.joints()["left_knee"] - 12) < 0.1
+    board.move_servos({numpy.int64(16): numpy.uint16(7600)}, frames=1)
+    with pytest.raises(pyrcb4.UsageError, match="ICS number"):
+        board.move_servos({"16": 7500})
+    board.write(0x0460, bytearray(b"\x01\x02"))
+    board.write(0x0462, numpy.array([3, 4], dtype=numpy.uint8))
+    board.write(0x0464, memoryview(b"\x05"))
+    assert board.read(0x0460, 5) == b"\x01\x02\x03\x04\x05" and board.read(0x0460, 0) == b""
+
+
+def test_device_errors_carry_errno():
+    import errno
+    with pytest.raises(pyrcb4.DeviceError) as e:
+        pyrcb4.Board("/dev/rcb4-no-such-port")
+    assert e.value.errno == errno.ENOENT and "rcb4-no-such-port" in str(e.value)

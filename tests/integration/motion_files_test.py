@@ -155,7 +155,7 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(rc == 2 and ".bin" in err, f"--backup not .bin: exit 2 ({rc}: {err.strip()!r})")
     write("calls9.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - call: 9\n  - end\n")
     rc, out, err = run(*on, "motion", "push", "calls9.yaml", "6")
-    check(rc == 1 and "step 1 calls 0x004B80, which holds no motion" in err, f"push of a call of an empty slot: exit 1 ({rc}: {err.strip()!r})")
+    check(rc == 1 and "step 1 (calls9.yaml:4) calls motion 9 (0x004B80), which holds no motion" in err, f"push of a call of an empty slot: exit 1 ({rc}: {err.strip()!r})")
     # A ROM motion that calls an empty slot (written raw): the board's program stops on an error.
     run(*on, "write", "rom", "0x3B80", "07 0C 80 4B 00 00 DE 03 0D 10")
     rc, out, err = run(*on, "motion", "play", "7", "--wait", "--timeout", "5")
@@ -167,6 +167,8 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(rc == 1 and "resuming would stop it again" in err, f"resume after a program error: refused ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "play", "1", "--wait", "--timeout", "5")
     check(rc == 0, f"motion play 1 starts the program afresh ({rc}: {err.strip()!r})")
+    rc, out, err = run("--json", *on, "config")
+    check(rc == 0 and json.loads(out)["program_error"] is False, "and clears the old program error")
     run(*on, "write", "rom", "0x3B80", "FF FF FF FF FF FF FF FF FF FF")
     rc, out, err = run(*on, "motion", "erase", "9")
     check(rc == 0 and "already empty" in out, f"erase of an empty slot writes nothing ({rc}: {out.strip()!r})")
@@ -218,6 +220,31 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     out, err = proc.communicate(timeout=10)
     check(proc.returncode == 130 and "interrupted at step" in err and time.monotonic() - sent < 1.0,
           f"Ctrl-C stops a motion played from the host within 1 s ({proc.returncode}: {err.strip()!r})")
+
+    # Ctrl-C while a file waits for a ROM motion it called (one that never ends): within 1 s, and
+    # the motion stopped on the board too.
+    run(*on, "motion", "push", "forever.yaml", "10", "--backup", "ten.bin")
+    write("call10.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - call: 10\n  - end\n")
+    proc = subprocess.Popen([RCB4, *on, "motion", "play", "call10.yaml"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.0)
+    sent = time.monotonic()
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    rc, st, _ = run("--json", *on, "motion", "status")
+    st = json.loads(st) if rc == 0 else {}
+    check(proc.returncode == 130 and time.monotonic() - sent < 1.0 and "was stopped" in err and not st.get("running"),
+          f"Ctrl-C during a called ROM motion: exit 130 within 1 s, the motion stopped ({proc.returncode}: {err.strip()!r} {st})")
+    # Stopped part way in motion 10: its slot is not written over, resume would land in new bytes.
+    rc, out, err = run(*on, "motion", "erase", "10")
+    check(rc == 1 and "stopped part way" in err, f"erase of a slot stopped part way: exit 1 ({rc}: {err.strip()!r})")
+    run(*on, "rom", "backup", "pre10.bin")
+    rc, out, err = run(*on, "rom", "restore", "pre10.bin")
+    check(rc == 1 and "stopped part way" in err, f"rom restore with a motion stopped part way: exit 1 ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "play", "1", "--wait", "--timeout", "5")
+    check(rc == 0, f"motion play 1 starts afresh ({rc}: {err.strip()!r})")
+    # A named layout the ROM contradicts is refused before anything is read or written with it.
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "2", "--layout", "2.0")
+    check(rc == 1 and "another layout than this board's ROM has" in err, f"--layout 2.0 on a 2.2 board: exit 1 ({rc}: {err.strip()!r})")
 
     # Motion 1 tells the layout: erased, the hint to put it back names --layout.
     rc, out, err = run(*on, "motion", "erase", "1", "--backup", "one.bin")
@@ -297,13 +324,13 @@ def at(t):
     while time.monotonic() - t0 < t:
         time.sleep(0.005)
 at(0.7)
-for k in range(1, 11):   # +40 deg over 0.5 s
-    head_at(4 * k)
-    at(0.7 + 0.05 * k)
+for k in range(1, 41):   # +40 deg over 0.5 s, in steps of 1 deg (finer than the 2 deg threshold)
+    head_at(k)
+    at(0.7 + 0.0125 * k)
 at(1.8)
-for k in range(1, 11):   # back over 0.5 s
-    head_at(40 - 4 * k)
-    at(1.8 + 0.05 * k)
+for k in range(1, 41):   # back over 0.5 s
+    head_at(40 - k)
+    at(1.8 + 0.0125 * k)
 out, err = rec.communicate(timeout=20)
 taught = open("taught.yaml").read() if os.path.exists("taught.yaml") else ""
 poses = [l for l in taught.splitlines() if l.strip().startswith("- pose:")]
@@ -318,6 +345,12 @@ check(len(consts) >= 2 and b"\x00\x80" in bytes(consts[0]) and b"\xff\x7f" in by
 rc, out, err = run("--device", StandIn().path, "motion", "record", "legs.yaml", "--joints", "legs", "--for", "1")
 check(rc == 1 and "no servo allocated for left_hip_roll" in err and not os.path.exists("legs.yaml"),
       f"record of joints the board has no servo for: exit 1 ({rc}: {err.strip()!r})")
+rc, out, err = run("--device", StandIn().path, "motion", "record", "/nonexistent-dir/x.yaml", "--free", "--for", "2")
+check(rc == 3 and "cannot be written" in err and "nothing recorded" in err, f"record to a place it cannot write: exit 3 at once ({rc}: {err.strip()!r})")
+dying = StandIn(mode="die", die_after=40)
+rc, out, err = run("--device", dying.path, "motion", "record", "died.yaml", "--joints", "head_yaw", "--every", "20", "--for", "5")
+check(rc == 4 and os.path.exists("died.yaml") and "recorded before the board stopped answering are in died.yaml" in err,
+      f"a board that dies mid-recording: exit 4, what was recorded kept ({rc}: {err.strip()[-200:]!r})")
 rec = subprocess.Popen([RCB4, "--device", StandIn().path, "motion", "record", "stopped.yaml", "--joints", "head_yaw"],
                        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 time.sleep(1.0)

@@ -76,6 +76,7 @@ class play_motion {
       if (power_ == servo_power::release) c.ics_enabled = false;
       suspend_ = detail::le(c.encode());
       c.rom_program = c.vector_jump = c.ics_enabled = true;
+      c.program_error = false;  // a fresh start: an error of the program that ran before is history
       resumed_ = c.encode();
       resume_ = detail::le(resumed_);
     } else if (step_ == 1) {

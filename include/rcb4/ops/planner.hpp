@@ -32,9 +32,9 @@ struct byte_range {
 struct link_cost {
   std::chrono::nanoseconds byte_time{88'000};    ///< one byte on the wire (8E1: 11 bits; default 1.25 Mbaud)
   std::chrono::nanoseconds exchange{1'000'000};  ///< per-exchange overhead (FTDI low latency ≈ 1 ms)
-  /** The cost of a link at @p baud with @p overhead per exchange. */
+  /** The cost of a link at @p baud with @p overhead per exchange; a baud of 0 (unknown) is taken as 115200, the slowest. */
   static link_cost at(std::uint32_t baud, std::chrono::nanoseconds overhead) {
-    return {std::chrono::nanoseconds(11'000'000'000LL / baud), overhead};
+    return {std::chrono::nanoseconds(11'000'000'000LL / (baud ? baud : 115200u)), overhead};
   }
   /** Time of one read of @p n bytes. */
   std::chrono::nanoseconds read(std::uint32_t n) const { return exchange + byte_time * (10 + n + 3); }
