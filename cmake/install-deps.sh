@@ -18,6 +18,8 @@ packages=(
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
   pybind11-dev python3-dev python3-pytest python3-numpy python3-serial  # pyrcb4, its tests, its benchmark
+  python3-rospy python3-rosmaster python3-rostopic python3-sensor-msgs python3-trajectory-msgs \
+  python3-std-srvs python3-std-msgs python3-diagnostic-msgs  # rcb4_ros: ROS 1's Python side only (its C++ packages would remove libboost1.81-dev)
 )
 
 missing=()
@@ -47,3 +49,8 @@ export DEBIAN_FRONTEND=noninteractive
 # An empty or stale package list finds nothing; refresh it once.
 $sudo apt-get update -qq
 $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# ROS 1's C++ development packages conflict with Boost 1.81's: make sure nothing took it away.
+if [ "$(dpkg-query -W -f='${Status}' libboost1.81-dev 2>/dev/null)" != "install ok installed" ]; then
+  echo "rcb4: libboost1.81-dev is no longer installed (a ROS C++ package removes it); reinstall it" >&2
+  exit 1
+fi

@@ -189,6 +189,25 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             return out;
           },
           "The profile's joints, in the order of angle_vector().")
+      .def_property_readonly(
+          "joint_limits",
+          [](const board& b) {
+            py::dict d;
+            for (const auto& j : b.robot().joints()) d[py::str(j.name)] = py::make_tuple(j.lower, j.upper);
+            return d;
+          },
+          "Each joint's (lower, upper) limit in degrees, from the profile: what move() and write() enforce.")
+      .def_property_readonly(
+          "period",
+          [](board& b) {
+            rcb4::config_word c;
+            {
+              py::gil_scoped_release release;
+              c = b.config();
+            }
+            return rcb4::milliseconds(c.period) / 1000.0;
+          },
+          "The board's output period in seconds (one interpolation frame).")
       .def(
           "joints",
           [](board& b) {

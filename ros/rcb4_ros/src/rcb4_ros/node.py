@@ -1,0 +1,264 @@
+# rcb4_ros: a ROS 1 node for KONDO's RCB-4 (KHR-3HV, KXR) over pyrcb4. One thread owns the line:
+# callbacks only check what they are given and queue it; the loop reads the joints once per
+# cycle, publishes them, and carries out what was queued. Standard messages only; SI units.
+# SPDX-License-Identifier: BSL-1.0
+import json
+import math
+import queue
+import threading
+import time
+
+import numpy
+import rospy
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from sensor_msgs.msg import BatteryState, JointState
+from std_msgs.msg import String, UInt8
+from std_srvs.srv import Trigger, TriggerResponse
+from trajectory_msgs.msg import JointTrajectory
+
+import pyrcb4
+
+
+class Rcb4Node:
+    """The node: parameters ~device (empty: the in-process virtual board), ~baud, ~robot, ~rate
+    (default: one cycle per board output period), ~joint_prefix, ~timeout."""
+
+    def __init__(self):
+        device = rospy.get_param("~device", "") or None
+        baud = int(rospy.get_param("~baud", 0)) or None
+        robot = rospy.get_param("~robot", "khr-3hv")
+        self.prefix = rospy.get_param("~joint_prefix", "")
+        self.board = pyrcb4.Board(device, baud=baud, robot=robot, timeout=float(rospy.get_param("~timeout", 0.1)))
+        self.period = self.board.period
+        self.rate = float(rospy.get_param("~rate", 1.0 / self.period))
+        if not 0 < self.rate <= 1000:
+            raise ValueError(f"~rate: {self.rate} Hz is outside 0..1000")
+        self.names = self.board.joint_names
+        self.limits = self.board.joint_limits
+        self.index = {self.prefix + n: i for i, n in enumerate(self.names)}
+        self.loop = self.board.control_loop()
+        self.angles = numpy.full(len(self.names), numpy.nan)
+        self.requests = queue.Queue()  # (what, argument, reply) for the loop thread
+        self.lock = threading.Lock()   # guards the trajectory and the streamed target
+        self.trajectory = []           # [(due monotonic time, targets in degrees, frames)], next first
+        self.stream = None             # (targets in degrees, received) from ~joint_command
+        self.link_ok, self.link_reason = True, ""
+        self.cycles, self.errors, self.timeouts = 0, 0, 0
+        self.rate_window = (time.monotonic(), 0)
+        self.cycles_per_s = 0.0
+        self.last_motion = None
+        self.states = rospy.Publisher("joint_states", JointState, queue_size=10)
+        self.motion_pub = rospy.Publisher("~motion", String, queue_size=2, latch=True)
+        self.sensors_pub = rospy.Publisher("~sensors", String, queue_size=2)
+        self.battery_pub = rospy.Publisher("~battery", BatteryState, queue_size=2)
+        self.diag_pub = rospy.Publisher("diagnostics", DiagnosticArray, queue_size=2)
+        rospy.Subscriber("~command", JointTrajectory, self.on_trajectory, queue_size=2)
+        rospy.Subscriber("~joint_command", JointState, self.on_joint_command, queue_size=1)
+        rospy.Subscriber("~free_joints", String, lambda m: self.queue("free", m.data), queue_size=5)
+        rospy.Subscriber("~hold_joints", String, lambda m: self.queue("hold", m.data), queue_size=5)
+        rospy.Subscriber("~play_motion", UInt8, lambda m: self.queue("play", m.data), queue_size=5)
+        rospy.Service("~free", Trigger, lambda r: self.trigger("free", ""))
+        rospy.Service("~hold", Trigger, lambda r: self.trigger("hold", ""))
+        rospy.Service("~stop_motion", Trigger, lambda r: self.trigger("stop", None))
+        rospy.loginfo("rcb4: %s, %d joints, %.0f Hz (output period %.0f ms)", self.board.where, len(self.names),
+                      self.rate, self.period * 1000)
+
+    # --- callbacks: check, queue, never touch the line ----------------------------------------------
+    def degrees_of(self, names, positions, what):
+        """Degrees for every joint (NaN: not given), or a refusal naming the joint and the limit."""
+        if len(names) != len(positions):
+            raise ValueError(f"{what}: {len(names)} names but {len(positions)} positions")
+        targets = numpy.full(len(self.names), numpy.nan)
+        for name, rad in zip(names, positions):
+            i = self.index.get(name)
+            if i is None:
+                raise ValueError(f"{what}: no joint is called '{name}'")
+            deg = math.degrees(rad)
+            lower, upper = self.limits[self.names[i]]
+            if not (lower - 1e-6 <= deg <= upper + 1e-6):
+                raise ValueError(f"{what}: {name}: {deg:.2f} degrees is beyond its "
+                                 f"{'lower' if deg < lower else 'upper'} limit {lower if deg < lower else upper:g}")
+            targets[i] = deg
+        return targets
+
+    def on_trajectory(self, msg):
+        try:
+            points, start, last = [], 0.0, 0.0
+            for k, p in enumerate(msg.points):
+                targets = self.degrees_of(msg.joint_names, p.positions, f"point {k}")
+                t = p.time_from_start.to_sec()
+                if t < last:
+                    raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
+                frames = round((t - last) / self.period)
+                if frames > 255:
+                    raise ValueError(f"point {k}: {t - last:.3f} s from the one before is more than a move takes "
+                                     f"(255 periods of {self.period * 1000:.0f} ms)")
+                points.append((last, targets, max(frames, 1) if t > last else 0))
+                last = t
+        except ValueError as e:
+            rospy.logerr("rcb4: trajectory refused, nothing moves: %s", e)
+            return
+        stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
+        begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
+        with self.lock:  # a newer trajectory replaces what is left of the old one
+            self.trajectory = [(begin + at, targets, frames) for at, targets, frames in points]
+            self.stream = None
+
+    def on_joint_command(self, msg):
+        try:
+            targets = self.degrees_of(msg.name, msg.position, "joint_command")
+        except ValueError as e:
+            rospy.logerr("rcb4: joint_command refused, nothing moves: %s", e)
+            return
+        with self.lock:
+            self.stream = targets
+            self.trajectory = []
+
+    def queue(self, what, argument, reply=None):
+        self.requests.put((what, argument, reply))
+
+    def trigger(self, what, argument):
+        done = threading.Event()
+        result = {}
+        self.queue(what, argument, (done, result))
+        if not done.wait(2.0):
+            return TriggerResponse(False, "the board did not answer in 2 s")
+        return TriggerResponse(result.get("ok", False), result.get("message", ""))
+
+    # --- the loop: the only thread on the line ------------------------------------------------------
+    def carry_out(self):
+        while True:
+            try:
+                what, argument, reply = self.requests.get_nowait()
+            except queue.Empty:
+                return
+            ok, message = True, ""
+            try:
+                if what in ("free", "hold"):
+                    names = [n[len(self.prefix):] if n.startswith(self.prefix) else n
+                             for n in (argument or "").replace(",", " ").split()]
+                    done = (self.board.free if what == "free" else self.board.hold)(*names)
+                    message = f"{what}: {len(done)} joints"
+                elif what == "play":
+                    self.board.play_motion(int(argument), wait=False)
+                    message = f"playing motion {argument}"
+                elif what == "stop":
+                    self.board.stop_motion()
+                    message = "motion stopped"
+            except pyrcb4.Error as e:
+                ok, message = False, str(e)
+                rospy.logerr("rcb4: %s: %s", what, e)
+            if reply:
+                reply[1].update(ok=ok, message=message)
+                reply[0].set()
+
+    def write_due(self):
+        now = time.monotonic()
+        with self.lock:
+            due = None
+            while self.trajectory and self.trajectory[0][0] <= now:
+                due = self.trajectory.pop(0)
+            stream, self.stream = self.stream, None
+        if due:
+            self.loop.write(due[1], frames=due[2])
+        elif stream is not None:
+            self.loop.write(stream, frames=max(1, round(1.0 / self.rate / self.period)))
+
+    def cycle(self):
+        self.carry_out()
+        self.write_due()
+        self.loop.read(out=self.angles)
+        stamp = rospy.Time.now()
+        msg = JointState()
+        msg.header.stamp = stamp
+        for name, deg in zip(self.names, self.angles):
+            if not math.isnan(deg):  # a servo that does not answer is left out, never made up
+                msg.name.append(self.prefix + name)
+                msg.position.append(math.radians(deg))
+        self.states.publish(msg)
+        self.cycles += 1
+
+    def slow_things(self):
+        try:
+            st = self.board.motion_status()
+        except pyrcb4.BoardRefused as e:  # a board without an HTH4 program: no motions, the link is fine
+            st = {"running": False, "motion": None, "error": str(e)}
+        if st != self.last_motion:
+            self.motion_pub.publish(String(json.dumps(st)))
+            self.last_motion = st
+        s = self.board.sensors()
+        self.sensors_pub.publish(String(json.dumps(
+            {"battery_volts": s["battery_volts"], "ad_volts": s["ad_volts"], "buttons": s["button_names"]})))
+        b = BatteryState()
+        b.header.stamp = rospy.Time.now()
+        b.voltage = s["battery_volts"]
+        b.present = True
+        self.battery_pub.publish(b)
+
+    def diagnostics(self):
+        now = time.monotonic()
+        since, count = self.rate_window
+        if now - since >= 1.0:
+            self.cycles_per_s = (self.cycles - count) / (now - since)
+            self.rate_window = (now, self.cycles)
+        st = DiagnosticStatus()
+        st.name = "rcb4: link"
+        st.hardware_id = self.board.where
+        missing = [self.prefix + n for n, d in zip(self.names, self.angles) if math.isnan(d)]
+        if not self.link_ok:
+            st.level, st.message = DiagnosticStatus.ERROR, f"the board does not answer: {self.link_reason}"
+        elif missing:
+            st.level, st.message = DiagnosticStatus.WARN, f"{len(missing)} joints do not answer"
+        else:
+            st.level, st.message = DiagnosticStatus.OK, "all joints answer"
+        st.values = [KeyValue("cycles_per_s", f"{self.cycles_per_s:.1f}"), KeyValue("rate", f"{self.rate:g}"),
+                     KeyValue("errors", str(self.errors)), KeyValue("timeouts", str(self.timeouts)),
+                     KeyValue("missing_joints", " ".join(missing))]
+        a = DiagnosticArray()
+        a.header.stamp = rospy.Time.now()
+        a.status = [st]
+        self.diag_pub.publish(a)
+
+    def run(self):
+        period = 1.0 / self.rate
+        next_cycle = time.monotonic()
+        last_slow = last_diag = 0.0
+        try:
+            while not rospy.is_shutdown():
+                try:
+                    self.cycle()
+                    if not self.link_ok:
+                        rospy.loginfo("rcb4: the board answers again")
+                    self.link_ok = True
+                    if time.monotonic() - last_slow >= 0.2:
+                        self.slow_things()
+                        last_slow = time.monotonic()
+                except pyrcb4.Error as e:
+                    # No joint_states until it answers again: nothing stale is published.
+                    self.errors += 1
+                    if isinstance(e, pyrcb4.Timeout):
+                        self.timeouts += 1
+                    if self.link_ok:
+                        rospy.logerr("rcb4: %s", e)
+                    self.link_ok, self.link_reason = False, str(e)
+                    self.angles[:] = numpy.nan
+                if time.monotonic() - last_diag >= 1.0:
+                    self.diagnostics()
+                    last_diag = time.monotonic()
+                next_cycle = max(next_cycle + period, time.monotonic() - period)
+                delay = next_cycle - time.monotonic()
+                while delay > 0 and not rospy.is_shutdown():
+                    time.sleep(min(delay, 0.05))  # wakes for shutdown within 50 ms
+                    delay = next_cycle - time.monotonic()
+        finally:
+            self.board.close()
+
+
+def main():
+    rospy.init_node("rcb4")
+    try:
+        node = Rcb4Node()
+    except (pyrcb4.Error, ValueError) as e:
+        rospy.logfatal("rcb4: %s", e)
+        raise SystemExit(1)
+    node.run()

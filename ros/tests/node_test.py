@@ -1,0 +1,164 @@
+#!/usr/bin/env python3
+# The rcb4 ROS node against a real ROS master (rosmaster --core on a free port): joint_states at
+# the asked rate with every joint, a trajectory that moves left_knee (checked through the rcb4 tool
+# once the node has let the board go), a point beyond a limit that moves nothing, free and hold,
+# SIGINT within 1 s; then on a board of our own that falls silent: diagnostics ERROR and no stale
+# joint_states until it answers again.
+#   node_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR
+# SPDX-License-Identifier: BSL-1.0
+import json
+import math
+import os
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "..", "..", "tests", "integration"))
+from checks import check, finish  # noqa: E402
+from standin import StandIn  # noqa: E402
+
+RCB4, PYRCB4, NODE_SRC = sys.argv[1], sys.argv[2], sys.argv[3]
+NODE = os.path.join(NODE_SRC, "..", "scripts", "rcb4_node")
+
+with socket.socket() as s:
+    s.bind(("127.0.0.1", 0))
+    port = s.getsockname()[1]
+env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=tempfile.mkdtemp(prefix="rcb4-ros-"),
+           PYTHONPATH=os.pathsep.join([PYRCB4, NODE_SRC, os.environ.get("PYTHONPATH", "")]))
+os.environ.update(env)
+master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+import rosgraph  # noqa: E402
+import rospy  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_srvs.srv import Trigger  # noqa: E402
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E402
+
+for _ in range(100):
+    try:
+        rosgraph.Master("/rcb4_test").getPid()
+        break
+    except Exception:  # noqa: BLE001 (not up yet)
+        time.sleep(0.1)
+rospy.init_node("rcb4_test", anonymous=True, disable_signals=True)
+
+states, diags = [], []
+rospy.Subscriber("/joint_states", JointState, lambda m: states.append((time.monotonic(), m)), queue_size=100)
+rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: diags.append((time.monotonic(), m)), queue_size=10)
+
+
+def start_node(*params):
+    return subprocess.Popen([sys.executable, NODE, *params], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
+
+
+def wait_for(pred, timeout=10):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        v = pred()
+        if v:
+            return v
+        time.sleep(0.05)
+    return None
+
+
+def stop(node):
+    sent = time.monotonic()
+    node.send_signal(signal.SIGINT)
+    try:
+        node.wait(timeout=5)
+    except subprocess.TimeoutExpired:
+        node.kill()
+        node.wait()
+    return time.monotonic() - sent
+
+
+def last_position(name):
+    for _, m in reversed(states):
+        if name in m.name:
+            return math.degrees(m.position[m.name.index(name)])
+    return None
+
+
+def tool_joints(dev):
+    r = subprocess.run([RCB4, "--json", "--device", dev, "joint", "list"], capture_output=True, text=True, timeout=30)
+    return {j["name"]: j for j in json.loads(r.stdout)} if r.returncode == 0 else {}
+
+
+try:
+    srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+    dev = srv.stdout.readline().strip()
+    node = start_node(f"_device:={dev}", "_rate:=50")
+    first = wait_for(lambda: len(states) > 5, timeout=15)
+    check(first is not None, "the node publishes joint_states")
+    states.clear()
+    time.sleep(2.0)
+    got = [m for t, m in states]
+    rate = len(got) / 2.0
+    check(rate >= 45 and all(len(m.name) == 20 and len(m.position) == 20 for m in got),
+          f"joint_states at >= 90% of 50 Hz with every joint of the KHR-3HV ({rate:.1f} Hz)")
+    check(all(m.header.stamp.to_sec() > 0 for m in got) and "left_knee" in got[-1].name, "stamped, by joint name")
+
+    cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2, latch=False)
+    wait_for(lambda: cmd.get_num_connections() > 0)
+
+    def trajectory(points):
+        t = JointTrajectory()
+        t.joint_names = ["left_knee"]
+        for deg, secs in points:
+            t.points.append(JointTrajectoryPoint(positions=[math.radians(deg)], time_from_start=rospy.Duration(secs)))
+        cmd.publish(t)
+    trajectory([(20, 0.3), (35, 0.6)])
+    check(wait_for(lambda: (p := last_position("left_knee")) is not None and abs(p - 35) < 1, timeout=5),
+          f"a trajectory brings left_knee to its last point, within 1 deg ({last_position('left_knee')})")
+    trajectory([(140, 0.5)])
+    time.sleep(1.0)
+    check(abs(last_position("left_knee") - 35) < 0.5, f"a point beyond the limit moves nothing ({last_position('left_knee')})")
+
+    free = rospy.ServiceProxy("/rcb4/free", Trigger)
+    hold = rospy.ServiceProxy("/rcb4/hold", Trigger)
+    r1, r2 = hold(), free()
+    check(r1.success and r2.success and "20 joints" in r2.message, f"~hold and ~free answer ({r1.message!r}, {r2.message!r})")
+    took = stop(node)
+    out = node.stdout.read()
+    check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
+    check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
+    j = tool_joints(dev)
+    check(j and abs(j["left_knee"]["degrees"] - 35) < 1 and all(v["state"] == "free" for v in j.values()),
+          f"on the board (rcb4 joint list): left_knee at 35, every joint free ({j.get('left_knee')})")
+    srv.terminate()
+    srv.wait(timeout=10)
+
+    # A board that stops answering, then answers again.
+    board = StandIn()
+    states.clear()
+    diags.clear()
+    node = start_node(f"_device:={board.path}", "_baud:=115200", "_rate:=20")
+    check(wait_for(lambda: len(states) > 5, timeout=15), "on a stand-in board: joint_states")
+    check(all(len(m.name) == 3 for _, m in states[-3:]), "only the joints whose servos answer (3 of 20)")
+    check(wait_for(lambda: any(d.status[0].level == DiagnosticStatus.WARN and "17 joints" in d.status[0].message
+                               for _, d in diags), timeout=5),
+          f"diagnostics: the joints that do not answer ({[(d.status[0].level, d.status[0].message) for _, d in diags][:3]})")
+    board.silent = True
+    went = time.monotonic()
+    check(wait_for(lambda: any(t > went and d.status[0].level == DiagnosticStatus.ERROR for t, d in diags), timeout=5),
+          "a silent board: diagnostics ERROR")
+    time.sleep(0.5)
+    quiet = time.monotonic()
+    time.sleep(1.0)
+    check(not [t for t, _ in states if t > quiet], "and no joint_states while it is silent")
+    board.silent = False
+    back = time.monotonic()
+    check(wait_for(lambda: [t for t, _ in states if t > back], timeout=5), "joint_states again once it answers")
+    stop(node)
+finally:
+    rospy.signal_shutdown("done")
+    master.terminate()
+    master.wait(timeout=10)
+
+finish()
