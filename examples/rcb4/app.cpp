@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <ctime>
+
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
 #include <rcb4/transport/tcp.hpp>
@@ -21,6 +23,15 @@ void emit(const json& j) {
   // Names from a profile file may be any bytes: invalid UTF-8 becomes U+FFFD, never an exception.
   fmt::print("{}\n", j.dump(-1, ' ', false, json::error_handler_t::replace));
   std::fflush(stdout);
+}
+
+std::string file_stamp() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  ::localtime_r(&t, &tm);
+  char b[32];
+  std::strftime(b, sizeof b, "%Y%m%d-%H%M%S", &tm);
+  return b;
 }
 
 std::string plural(std::size_t n, std::string_view word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }

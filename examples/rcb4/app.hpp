@@ -73,6 +73,8 @@ using json = nlohmann::ordered_json;
 /** Prints @p j on one line of stdout. */
 void emit(const json& j);
 
+/** The local time for file names: "20261124-230605". */
+std::string file_stamp();
 /** "1 byte", "2 bytes". */
 std::string plural(std::size_t n, std::string_view word);
 /** A duration for people: "640 us", "501.1 ms", "12.34 s". */

@@ -72,20 +72,11 @@ std::size_t code_size(const mo::listing& l) {
 /** The board's output period (config bits 4-5). */
 rcb4::output_period board_period(session& s) { return s.run(rcb4::ops::read_config{}).period; }
 
-std::string now_stamp() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::localtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y%m%d-%H%M%S", &tm);
-  return b;
-}
-
 /** Saves @p bytes (a slot's old contents) to @p path, or to motion-N-DATE.bin when it is empty. */
 std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, unsigned n) {
   if (path.empty()) {
-    path = fmt::format("motion-{}-{}.bin", n, now_stamp());
-    for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", n, now_stamp(), k);
+    path = fmt::format("motion-{}-{}.bin", n, file_stamp());
+    for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", n, file_stamp(), k);
   }
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
@@ -187,7 +178,7 @@ int pull(session& s, const pull_options& o, const globals& g) {
   std::string comment = fmt::format(
       "motion {} of the board (0x{:06X}, {} layout), pulled by rcb4 on {}\n"
       "rcb4 motion push {} {} writes it back",
-      n, where.address.value(), layout.name, now_stamp(), o.file, n);
+      n, where.address.value(), layout.name, file_stamp(), o.file, n);
   try {
     ro::save_motion(o.file, d, comment);
   } catch (const ro::profile_error& e) {

@@ -22,15 +22,6 @@ std::uint32_t crc32(std::span<const std::uint8_t> b) {
   return c.checksum();
 }
 
-std::string stamp() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::localtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y%m%d-%H%M%S", &tm);
-  return b;
-}
-
 /** The whole ROM, with a progress line on a terminal. */
 std::vector<std::uint8_t> read_all(session& s, const std::string& what, const globals& g) {
   rcb4::ops::read_memory op(memory::rom, 0, rcb4::rom_size);
@@ -54,7 +45,7 @@ void save(const std::string& path, std::span<const std::uint8_t> image, const st
   out.flush();
   std::ofstream sum(path + ".crc32", std::ios::trunc);
   sum << fmt::format("{:08x}  {}  {} bytes  {}  {}\n", crc32(image), std::filesystem::path(path).filename().string(),
-                     image.size(), stamp(), version);
+                     image.size(), file_stamp(), version);
   sum.flush();
   if (!out || !sum)
     throw failure(exit_usage, fmt::format("cannot write {} or its .crc32: {}", path, std::strerror(errno)),
@@ -112,10 +103,10 @@ int restore(session& s, const std::string& path, bool no_check, const globals& g
     throw failure(exit_board, fmt::format("motion {} is running: the restore would rewrite what it runs", *st.motion),
                   "rcb4 motion wait, or rcb4 motion stop, then restore");
   else if (st.suspended && st.motion)
-    throw failure(exit_board,
-                  fmt::format("motion {} is stopped part way: motion resume would continue in rewritten code",
-                              *st.motion),
-                  "rcb4 motion play N (any motion) starts the program afresh; then restore");
+    throw failure(
+        exit_board,
+        fmt::format("motion {} is stopped part way: motion resume would continue in rewritten code", *st.motion),
+        "rcb4 motion play N (any motion) starts the program afresh; then restore");
   const auto version = s.run(rcb4::ops::read_version{});
   const auto now = read_all(s, "reading ROM (the backup of what is replaced)", g);
   std::vector<std::size_t> differ;
@@ -136,7 +127,7 @@ int restore(session& s, const std::string& path, bool no_check, const globals& g
   if (cfg.rom_program) s.run(rcb4::ops::stop_motion{});
   // Beside the image being restored: where the user keeps ROM images.
   const std::string before =
-      (std::filesystem::path(path).parent_path() / fmt::format("rom-before-restore-{}.bin", stamp())).string();
+      (std::filesystem::path(path).parent_path() / fmt::format("rom-before-restore-{}.bin", file_stamp())).string();
   save(before, now, version);
   progress bar("writing ROM", differ.size(), g.json);
   for (std::size_t i = 0; i < differ.size(); ++i) {

@@ -21,8 +21,9 @@ class StandIn:
     allocation table of zeros (a board nobody set up), "late" answers 300 ms late, "die" stops
     answering after `die_after` frames (a board that loses power mid-transfer)."""
 
-    def __init__(self, silent=False, mode=None, die_after=20, tcp=False):
+    def __init__(self, silent=False, mode=None, die_after=20, tcp=False, pace_baud=0, latency_us=0):
         self.mode = mode
+        self.pace_baud, self.latency_us = pace_baud, latency_us  # reply no sooner than the wire would
         self.die_after = die_after
         self.ram = bytearray(0x490)
         self.ram[0:2] = bytes([0x8B, 0x00])  # config word 0x008B
@@ -60,6 +61,8 @@ class StandIn:
         total = (sum(b) + (0x5A if self.mode == "badsum" else 0)) & 0xFF
         if self.mode == "late":
             time.sleep(0.3)
+        if self.pace_baud or self.latency_us:  # the reply's bytes at 11 bits each, after the adapter's latency
+            time.sleep((len(b) + 1) * 11 / (self.pace_baud or 1e12) + self.latency_us / 1e6)
         if self.mode == "cut":  # the reply stops one byte short (a line that fails mid-reply)
             os.write(self.master, bytes(b))
             return
