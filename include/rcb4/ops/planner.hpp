@@ -32,7 +32,8 @@ struct byte_range {
 struct link_cost {
   std::chrono::nanoseconds byte_time{88'000};    ///< one byte on the wire (8E1: 11 bits; default 1.25 Mbaud)
   std::chrono::nanoseconds exchange{1'000'000};  ///< per-exchange overhead (FTDI low latency ≈ 1 ms)
-  /** The cost of a link at @p baud with @p overhead per exchange; a baud of 0 (unknown) is taken as 115200, the slowest. */
+  /** The cost of a link at @p baud with @p overhead per exchange; a baud of 0 (unknown) is taken as 115200, the
+   * slowest. */
   static link_cost at(std::uint32_t baud, std::chrono::nanoseconds overhead) {
     return {std::chrono::nanoseconds(11'000'000'000LL / (baud ? baud : 115200u)), overhead};
   }
