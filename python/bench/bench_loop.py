@@ -7,7 +7,7 @@
 #               length-first, and one CONST of the 35 servo slots
 #   planned     pyserial sending the same frames pyrcb4 plans (its reads, its CONST)
 #   C++ client  rcb4 bench's control cycle (the C++ client's own rate on the same board)
-# Every loop writes HOLD (nothing moves), so they all do the same work on the board.
+# Nothing moves: pyrcb4 writes every joint where it is, the pyserial loops HOLD (the same bytes).
 #   bench_loop.py RCB4 [SECONDS]      (PYTHONPATH: build/<preset>/python)
 # SPDX-License-Identifier: BSL-1.0
 import json
@@ -78,11 +78,10 @@ def measure(latency_us):
         with pyrcb4.Board(dev, baud=1250000) as b:
             loop = b.control_loop()
             q = numpy.empty(loop.size)
-            hold = numpy.full(loop.size, numpy.nan)  # NaN: keep the target, HOLD at first
 
             def py_cycle():
                 loop.read(out=q)
-                loop.write(hold)
+                loop.write(q)  # every joint to where it is: nothing moves, 20 targets written
             out["pyrcb4"] = rate(py_cycle)
             plan, slots = loop.plan, loop.slots
         with serial.Serial(dev, 1250000, parity=serial.PARITY_EVEN, timeout=0.5) as port:

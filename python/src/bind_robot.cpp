@@ -239,7 +239,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
     loop = board.control_loop()
     while True:
         q = loop.read()                 # numpy, degrees, in board.joint_names order (NaN: no answer)
-        loop.write(q + step, frames=1)  # one CONST of every target (NaN: keep that joint's target)
+        loop.write(q + step, frames=1)  # one CONST of the targets given (NaN: that joint left out)
 
 The reads are planned once for the link; nothing is allocated per cycle in C++.)")
       .def(
@@ -281,8 +281,8 @@ The reads are planned once for the link; nothing is allocated per cycle in C++.)
             l.send(frames);
           },
           "targets"_a, "frames"_a = 1,
-          "Sends every target (degrees; NaN keeps a joint's target) as one CONST reached in frames output periods; "
-          "a target beyond a limit raises LimitError and sends nothing.")
+          "Sends the targets (degrees; NaN leaves a joint out: it goes on to its earlier target) as one CONST "
+          "reached in frames output periods; a target beyond a limit raises LimitError and sends nothing.")
       .def_property_readonly("size", &control_loop::size, "How many joints (the profile's).")
       .def_property_readonly(
           "plan",

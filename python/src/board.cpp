@@ -404,15 +404,24 @@ std::optional<std::string> control_loop::set(const double* degrees) {
     if (const auto p = rcb4::robot::to_position(j, degrees[i]); !rcb4::robot::ok(p))
       return std::get<rcb4::robot::problem>(p).message;
   }
+  send_ = rcb4::servo_mask{};
   for (std::size_t i = 0; i < index_.size(); ++i)
-    if (!std::isnan(degrees[i])) targets_.set(static_cast<std::size_t>(index_[i]), degrees[i]);
+    if (!std::isnan(degrees[i])) {
+      targets_.set(static_cast<std::size_t>(index_[i]), degrees[i]);
+      send_.insert(b_.model_.joints()[i].ics);
+    }
   return std::nullopt;
 }
 
 void control_loop::send(unsigned frames) {
   const auto f = rcb4::frames::make(frames);
   if (!f) throw board_error(fault::usage, "frames: 0..255");
-  const auto c = targets_.frame(*f);
+  // Only the joints this write names: another joint still on its way to an earlier target must
+  // not be sent there again over these (fewer) frames, which would make it jump.
+  if (send_.empty()) return;
+  rcb4::servo_set<rcb4::servo_position> subset;
+  for (const auto ics : send_) subset.insert(ics, *targets_.targets().find(ics));
+  const auto c = rcb4::const_servo::make(subset, *f);
   if (!c) raise(c.error(), "write the targets");
   std::shared_lock life(b_.life_);
   t::error_code ec;

@@ -162,11 +162,11 @@ class control_loop {
   /** Reads every joint's angle into @p out (size() values; NaN: no servo, or it never answered). */
   void read(double* out);
   /**
-   * Takes the targets (size() degrees; NaN keeps a joint's previous target, HOLD at first). A
-   * target beyond a limit: the problem, and none of the new targets is kept.
+   * Takes the targets (size() degrees; NaN: the joint is left out of the next send()). A target
+   * beyond a limit: the problem, and none of the new targets is kept.
    */
   std::optional<std::string> set(const double* degrees);
-  /** Sends every target as one CONST, reached in @p frames output periods. */
+  /** Sends the joints the last set() named as one CONST reached in @p frames output periods (none: nothing). */
   void send(unsigned frames);
   /** The reads the planner chose: (address, size) of each. */
   const std::vector<rcb4::ops::byte_range>& plan() const noexcept { return reads_.plan(); }
@@ -183,6 +183,7 @@ class control_loop {
   rcb4::robot::read_joints reads_;
   rcb4::robot::joint_targets targets_;
   std::vector<std::ptrdiff_t> index_;  // profile joint → its place in targets_.joints(), or -1
+  rcb4::servo_mask send_;              // the joints the last set() named: what send() sends
 };
 
 /** Raises the board_error that @p ec is, with @p what (the operation) in its message. */

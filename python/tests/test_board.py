@@ -239,6 +239,16 @@ def test_control_loop(board):
     assert abs(loop.read()[k] - 25) < 0.1  # nothing was sent
     with pytest.raises(pyrcb4.UsageError):
         loop.write(numpy.zeros(3))
+    # A write names only its joints: one still on its way elsewhere goes on at its own pace.
+    h = board.joint_names.index("head_yaw")
+    board.move({"head_yaw": 60}, time=2.0, wait=False)
+    target[:] = numpy.nan
+    target[k] = 20.0
+    loop.write(target, frames=1)
+    time.sleep(0.3)
+    q = loop.read()
+    assert abs(q[k] - 20) < 0.1 and 0 < q[h] < 30, f"head_yaw must still be on its 2 s way ({q[h]})"
+    loop.write(numpy.full(20, numpy.nan))  # nothing named: nothing sent
 
 
 def test_config_fields_and_servos_by_ics(board):

@@ -35,7 +35,8 @@ master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subpr
 import rosgraph  # noqa: E402
 import rospy  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
-from sensor_msgs.msg import JointState  # noqa: E402
+from sensor_msgs.msg import BatteryState, JointState  # noqa: E402
+from std_msgs.msg import String, UInt8  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E402
 
@@ -120,6 +121,34 @@ try:
     time.sleep(1.0)
     check(abs(last_position("left_knee") - 35) < 0.5, f"a point beyond the limit moves nothing ({last_position('left_knee')})")
 
+    # A streamed command for one joint leaves another on its way: head_yaw's 2 s move goes on.
+    t = JointTrajectory()
+    t.joint_names = ["head_yaw"]
+    t.points = [JointTrajectoryPoint(positions=[math.radians(60)], time_from_start=rospy.Duration(2.0))]
+    cmd.publish(t)
+    time.sleep(0.3)
+    stream = rospy.Publisher("/rcb4/joint_command", JointState, queue_size=2)
+    wait_for(lambda: stream.get_num_connections() > 0)
+    stream.publish(JointState(name=["left_knee"], position=[math.radians(35)]))
+    time.sleep(0.3)
+    check(5 < last_position("head_yaw") < 45, f"a joint_command for left_knee does not make head_yaw jump ({last_position('head_yaw')})")
+    wait_for(lambda: abs(last_position("head_yaw") - 60) < 0.5, timeout=5)
+    battery = rospy.wait_for_message("/rcb4/battery", BatteryState, timeout=5)
+    check(battery.voltage > 5 and math.isnan(battery.percentage) and math.isnan(battery.current),
+          f"~battery: volts, and NaN for what the board does not measure ({battery.voltage}, {battery.percentage})")
+    # A ROM motion running: a trajectory is refused rather than fighting it.
+    play = rospy.Publisher("/rcb4/play_motion", UInt8, queue_size=2)
+    wait_for(lambda: play.get_num_connections() > 0)
+    play.publish(UInt8(3))
+    time.sleep(0.5)
+    t.points = [JointTrajectoryPoint(positions=[math.radians(-50)], time_from_start=rospy.Duration(0.2))]
+    cmd.publish(t)  # head_yaw, which motion 3 (a bow: hips and knees) leaves alone
+    time.sleep(0.5)
+    check(abs(last_position("head_yaw") - 60) < 0.5, f"a trajectory while motion 3 runs moves nothing ({last_position('head_yaw')})")
+    wait_for(lambda: "running\": false" in (rospy.wait_for_message("/rcb4/motion", String, timeout=5).data), timeout=10)
+    trajectory([(35, 0.2)])
+    wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
+
     free = rospy.ServiceProxy("/rcb4/free", Trigger)
     hold = rospy.ServiceProxy("/rcb4/hold", Trigger)
     r1, r2 = hold(), free()
@@ -128,6 +157,7 @@ try:
     out = node.stdout.read()
     check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
     check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
+    check("motion 3 is running on the board" in out, "the trajectory refused under motion 3 is logged")
     j = tool_joints(dev)
     check(j and abs(j["left_knee"]["degrees"] - 35) < 1 and all(v["state"] == "free" for v in j.values()),
           f"on the board (rcb4 joint list): left_knee at 35, every joint free ({j.get('left_knee')})")
@@ -156,6 +186,29 @@ try:
     back = time.monotonic()
     check(wait_for(lambda: [t for t, _ in states if t > back], timeout=5), "joint_states again once it answers")
     stop(node)
+
+    # A device that goes away (unplugged) and comes back under the same path (a udev link): the
+    # node opens it again by itself.
+    link = os.path.join(env["ROS_HOME"], "rcb4-link")
+    serve_a = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+    os.symlink(serve_a.stdout.readline().strip(), link)
+    states.clear()
+    diags.clear()
+    node = start_node(f"_device:={link}", "_rate:=20")
+    check(wait_for(lambda: len(states) > 3, timeout=15), "through a link to the device: joint_states")
+    serve_a.terminate()
+    serve_a.wait(timeout=10)
+    gone = time.monotonic()
+    check(wait_for(lambda: any(t > gone and d.status[0].level == DiagnosticStatus.ERROR for t, d in diags), timeout=5),
+          "the device gone: diagnostics ERROR")
+    serve_b = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+    os.remove(link)
+    os.symlink(serve_b.stdout.readline().strip(), link)
+    back = time.monotonic()
+    check(wait_for(lambda: [t for t, _ in states if t > back], timeout=6), "back under the same path: joint_states again")
+    stop(node)
+    serve_b.terminate()
+    serve_b.wait(timeout=10)
 finally:
     rospy.signal_shutdown("done")
     master.terminate()

@@ -5,6 +5,7 @@
 import json
 import math
 import queue
+import signal
 import threading
 import time
 
@@ -24,15 +25,21 @@ class Rcb4Node:
     (default: one cycle per board output period), ~joint_prefix, ~timeout."""
 
     def __init__(self):
-        device = rospy.get_param("~device", "") or None
-        baud = int(rospy.get_param("~baud", 0)) or None
-        robot = rospy.get_param("~robot", "khr-3hv")
+        self.device = rospy.get_param("~device", "") or None
+        self.baud = int(rospy.get_param("~baud", 0)) or None
+        self.robot = rospy.get_param("~robot", "khr-3hv")
+        self.timeout = float(rospy.get_param("~timeout", 0.1))
         self.prefix = rospy.get_param("~joint_prefix", "")
-        self.board = pyrcb4.Board(device, baud=baud, robot=robot, timeout=float(rospy.get_param("~timeout", 0.1)))
+        self.board = pyrcb4.Board(self.device, baud=self.baud, robot=self.robot, timeout=self.timeout)
         self.period = self.board.period
-        self.rate = float(rospy.get_param("~rate", 1.0 / self.period))
+        try:
+            self.rate = float(rospy.get_param("~rate", 1.0 / self.period))
+        except (TypeError, ValueError):
+            raise ValueError(f"~rate: {rospy.get_param('~rate')!r} is not a number of Hz") from None
         if not 0 < self.rate <= 1000:
-            raise ValueError(f"~rate: {self.rate} Hz is outside 0..1000")
+            raise ValueError(f"~rate: {self.rate:g} Hz: it must be above 0 and at most 1000")
+        self.reopen_at = None  # when the device went away: the next time to open it again
+        self.stopping = threading.Event()  # SIGINT/SIGTERM: the loop ends, the board is let go
         self.names = self.board.joint_names
         self.limits = self.board.joint_limits
         self.index = {self.prefix + n: i for i, n in enumerate(self.names)}
@@ -73,6 +80,10 @@ class Rcb4Node:
             i = self.index.get(name)
             if i is None:
                 raise ValueError(f"{what}: no joint is called '{name}'")
+            if not math.isnan(targets[i]):
+                raise ValueError(f"{what}: {name} is given twice")
+            if not math.isfinite(rad):
+                raise ValueError(f"{what}: {name}: {rad} is not a position")
             deg = math.degrees(rad)
             lower, upper = self.limits[self.names[i]]
             if not (lower - 1e-6 <= deg <= upper + 1e-6):
@@ -82,6 +93,10 @@ class Rcb4Node:
         return targets
 
     def on_trajectory(self, msg):
+        if not msg.points:  # an empty trajectory stops the one under way (the joints finish their current move)
+            with self.lock:
+                self.trajectory = []
+            return
         try:
             points, start, last = [], 0.0, 0.0
             for k, p in enumerate(msg.points):
@@ -96,7 +111,7 @@ class Rcb4Node:
                 points.append((last, targets, max(frames, 1) if t > last else 0))
                 last = t
         except ValueError as e:
-            rospy.logerr("rcb4: trajectory refused, nothing moves: %s", e)
+            rospy.logerr_throttle(1.0, f"rcb4: trajectory refused, nothing moves: {e}")
             return
         stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
         begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
@@ -108,7 +123,7 @@ class Rcb4Node:
         try:
             targets = self.degrees_of(msg.name, msg.position, "joint_command")
         except ValueError as e:
-            rospy.logerr("rcb4: joint_command refused, nothing moves: %s", e)
+            rospy.logerr_throttle(1.0, f"rcb4: joint_command refused, nothing moves: {e}")
             return
         with self.lock:
             self.stream = targets
@@ -159,6 +174,14 @@ class Rcb4Node:
             while self.trajectory and self.trajectory[0][0] <= now:
                 due = self.trajectory.pop(0)
             stream, self.stream = self.stream, None
+        motion = self.last_motion or {}
+        # A ROM motion in its slot (servos still moving from our own last command set the same flags: no motion).
+        if (due or stream is not None) and motion.get("running") and motion.get("motion") is not None:
+            rospy.logerr_throttle(1.0, f"rcb4: motion {motion.get('motion')} is running on the board: it "
+                                       "would fight the command, so nothing was sent (~stop_motion first)")
+            with self.lock:
+                self.trajectory = []
+            return
         if due:
             self.loop.write(due[1], frames=due[2])
         elif stream is not None:
@@ -192,8 +215,26 @@ class Rcb4Node:
         b = BatteryState()
         b.header.stamp = rospy.Time.now()
         b.voltage = s["battery_volts"]
+        nan = float("nan")  # what the board does not measure (the message says NaN, not 0)
+        b.temperature = b.current = b.charge = b.capacity = b.design_capacity = b.percentage = nan
+        b.power_supply_status = BatteryState.POWER_SUPPLY_STATUS_UNKNOWN
+        b.power_supply_health = BatteryState.POWER_SUPPLY_HEALTH_UNKNOWN
+        b.power_supply_technology = BatteryState.POWER_SUPPLY_TECHNOLOGY_UNKNOWN
         b.present = True
         self.battery_pub.publish(b)
+
+    def reopen(self):
+        self.reopen_at = time.monotonic() + 1.0
+        try:
+            board = pyrcb4.Board(self.device, baud=self.baud, robot=self.robot, timeout=self.timeout)
+        except pyrcb4.Error as e:
+            self.link_reason = f"{self.device} cannot be opened again: {e}"
+            return
+        old, self.board = self.board, board
+        old.close()
+        self.loop = self.board.control_loop()
+        self.reopen_at = None
+        rospy.loginfo("rcb4: %s opened again", self.device)
 
     def diagnostics(self):
         now = time.monotonic()
@@ -224,17 +265,20 @@ class Rcb4Node:
         next_cycle = time.monotonic()
         last_slow = last_diag = 0.0
         try:
-            while not rospy.is_shutdown():
+            while not (rospy.is_shutdown() or self.stopping.is_set()):
                 try:
                     self.cycle()
                     if not self.link_ok:
                         rospy.loginfo("rcb4: the board answers again")
                     self.link_ok = True
-                    if time.monotonic() - last_slow >= 0.2:
+                    if time.monotonic() - last_slow >= 0.2:  # 5 Hz, on a grid: no drift
                         self.slow_things()
-                        last_slow = time.monotonic()
+                        last_slow = max(last_slow + 0.2, time.monotonic() - 0.2)
                 except pyrcb4.Error as e:
-                    # No joint_states until it answers again: nothing stale is published.
+                    # No joint_states until it answers again: nothing stale is published. A device
+                    # that went away (unplugged) is opened again once a second, by its path.
+                    if isinstance(e, pyrcb4.DeviceError) and self.device and self.reopen_at is None:
+                        self.reopen_at = time.monotonic() + 1.0
                     self.errors += 1
                     if isinstance(e, pyrcb4.Timeout):
                         self.timeouts += 1
@@ -242,12 +286,14 @@ class Rcb4Node:
                         rospy.logerr("rcb4: %s", e)
                     self.link_ok, self.link_reason = False, str(e)
                     self.angles[:] = numpy.nan
+                if self.reopen_at is not None and time.monotonic() >= self.reopen_at:
+                    self.reopen()
                 if time.monotonic() - last_diag >= 1.0:
                     self.diagnostics()
                     last_diag = time.monotonic()
                 next_cycle = max(next_cycle + period, time.monotonic() - period)
                 delay = next_cycle - time.monotonic()
-                while delay > 0 and not rospy.is_shutdown():
+                while delay > 0 and not (rospy.is_shutdown() or self.stopping.is_set()):
                     time.sleep(min(delay, 0.05))  # wakes for shutdown within 50 ms
                     delay = next_cycle - time.monotonic()
         finally:
@@ -255,10 +301,18 @@ class Rcb4Node:
 
 
 def main():
-    rospy.init_node("rcb4")
+    # The node's own signal handling: the loop ends at once and lets the board go, then rospy shuts
+    # down (its own SIGINT path takes seconds).
+    rospy.init_node("rcb4", disable_signals=True)
     try:
         node = Rcb4Node()
     except (pyrcb4.Error, ValueError) as e:
         rospy.logfatal("rcb4: %s", e)
+        rospy.signal_shutdown("cannot start")
         raise SystemExit(1)
-    node.run()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: node.stopping.set())
+    try:
+        node.run()
+    finally:
+        rospy.signal_shutdown("stopped")
