@@ -37,7 +37,7 @@ std::pair<std::vector<std::pair<std::string, double>>, std::optional<double>> po
   }
   if (!py::isinstance<py::str>(pose) && !py::hasattr(pose, "__fspath__"))
     throw board_error(fault::usage, "a pose is a dict {joint: degrees} or a pose file's path");
-  const std::string path = py::str(py::module_::import("os").attr("fspath")(pose)).cast<std::string>();
+  const std::string path = path_of(pose);
   try {
     const auto p = rcb4::robot::load_pose(path, b.robot());
     std::optional<double> t;
@@ -297,7 +297,7 @@ The reads are planned once for the link; nothing is allocated per cycle in C++.)
   m.def(
       "load_pose",
       [](const py::object& path, const std::string& robot) {
-        const std::string p = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        const std::string p = path_of(path);
         try {
           const auto model = rcb4::robot::open_profile(robot);
           const auto pose = rcb4::robot::load_pose(p, model);
@@ -312,7 +312,7 @@ The reads are planned once for the link; nothing is allocated per cycle in C++.)
   m.def(
       "save_pose",
       [](const py::object& path, const py::dict& joints, const std::string& robot, std::optional<double> time) {
-        const std::string p = py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+        const std::string p = path_of(path);
         try {
           const auto model = rcb4::robot::open_profile(robot);
           rcb4::robot::pose pose{model.name(), {}, std::nullopt};

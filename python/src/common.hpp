@@ -54,6 +54,11 @@ inline std::vector<std::string> names_of(const py::args& args) {
   return out;
 }
 
+/** A path given as str or os.PathLike, as os.fspath gives it. */
+inline std::string path_of(const py::object& path) {
+  return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
+}
+
 /** Adds poses, trims, scan and the control loop to Board (bind_robot.cpp). */
 void bind_robot(py::module_& m, py::class_<board>& cls);
 

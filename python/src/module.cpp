@@ -70,7 +70,7 @@ std::unique_ptr<board> open_board(const py::object& device, const py::object& ba
   if (!device.is_none()) {
     if (!py::isinstance<py::str>(device) && !py::hasattr(device, "__fspath__"))
       throw board_error(fault::usage, "device: a path such as '/dev/ttyUSB0', 'tcp:HOST:PORT', or None");
-    path = py::str(py::module_::import("os").attr("fspath")(device)).cast<std::string>();
+    path = path_of(device);
     if (path.empty()) throw board_error(fault::usage, "device: '' names no device (None is the virtual board)");
   }
   const std::uint32_t b = baud.is_none() ? 0u : baud.cast<std::uint32_t>();
