@@ -15,13 +15,31 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <exception>
 #include <string_view>
 
 namespace {
-void check(bool ok) {
-  if (!ok) __builtin_trap();
+std::string_view current_input;  // printed when a property fails (a CI log then holds the input)
+
+/** Traps when a property does not hold, after naming it and printing the input escaped. */
+void check(bool ok, const char* what, int line) {
+  if (ok) return;
+  std::fprintf(stderr, "profile_fuzzer.cpp:%d: property failed: %s\ninput (%zu bytes): \"", line, what,
+               current_input.size());
+  for (const char c : current_input) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u == '\\' || u == '"')
+      std::fprintf(stderr, "\\%c", c);
+    else if (u >= 0x20 && u < 0x7F)
+      std::fputc(c, stderr);
+    else
+      std::fprintf(stderr, "\\x%02X", u);
+  }
+  std::fprintf(stderr, "\"\n");
+  __builtin_trap();
 }
+#define CHECK(x) check((x), #x, __LINE__)
 
 bool valid_utf8(std::string_view s) {
   for (std::size_t i = 0; i < s.size();) {
@@ -44,13 +62,13 @@ void motion_file(std::string_view text, const rcb4::robot::model& khr) {
   } catch (const profile_error&) {
     return;
   }
-  check(d.where.size() == d.steps.size() && !d.steps.empty());
+  CHECK(d.where.size() == d.steps.size() && !d.steps.empty());
   if (valid_utf8(text)) {
     try {
       const auto again = parse_motion(motion_yaml(d, "c"), "back.yaml", khr, "/nonexistent-rcb4-fuzz");
-      check(again.steps == d.steps && again.period == d.period);
-    } catch (const profile_error&) {
-      check(false);
+      CHECK(again.steps == d.steps && again.period == d.period);
+    } catch (const profile_error& e) {
+      check(false, e.what(), __LINE__);  // the file written back does not read
     }
   }
   const auto c = to_program(d, khr, rcb4::hth4_2_2, d.period);
@@ -60,46 +78,53 @@ void motion_file(std::string_view text, const rcb4::robot::model& khr) {
   if (!rcb4::motion::ok(b)) return;
   const auto& bytes = std::get<std::vector<std::uint8_t>>(b);
   const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where));
-  check(rcb4::motion::ok(p));
+  CHECK(rcb4::motion::ok(p));
   const auto back = to_program(from_program(std::get<rcb4::motion::program>(p), khr, rcb4::hth4_2_2, d.period), khr,
                                rcb4::hth4_2_2, d.period);
   // A pose of a joint beyond its limit cannot come out of to_program: the same limits pass again.
-  check(ok(back));
+  CHECK(ok(back));
   const auto b2 = rcb4::motion::assemble(std::get<compiled_motion>(back).program, where);
-  check(rcb4::motion::ok(b2) && std::get<std::vector<std::uint8_t>>(b2) == bytes);
+  CHECK(rcb4::motion::ok(b2) && std::get<std::vector<std::uint8_t>>(b2) == bytes);
 }
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rcb4::robot;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
+  current_input = text;
   static const model khr = open_profile("khr-3hv");
   try {
     const auto m = parse_profile(text, "fuzz.yaml");
-    check(ok(model::make(m.name(), m.joints(), m.groups(), m.motions())));
+    CHECK(ok(model::make(m.name(), m.joints(), m.groups(), m.motions())));
   } catch (const profile_error& e) {
-    check(std::string_view(e.what()).substr(0, 9) == "fuzz.yaml");
+    CHECK(std::string_view(e.what()).substr(0, 9) == "fuzz.yaml");
+  } catch (const std::exception& e) {
+    check(false, e.what(), __LINE__);  // only a profile_error may leave
   } catch (...) {
-    check(false);
+    CHECK(false);
   }
   try {
     const auto p = parse_pose(text, "fuzz.json", khr);
     for (std::size_t i = 0; i < p.joints.size(); ++i) {
-      check(khr.find(p.joints[i].first) != nullptr);
-      for (std::size_t k = 0; k < i; ++k) check(p.joints[k].first != p.joints[i].first);
+      CHECK(khr.find(p.joints[i].first) != nullptr);
+      for (std::size_t k = 0; k < i; ++k) CHECK(p.joints[k].first != p.joints[i].first);
     }
     const auto back = parse_pose(pose_json(p), "back.json", khr);
-    check(back.joints.size() == p.joints.size());
-    for (std::size_t i = 0; i < p.joints.size(); ++i) check(back.joints[i].first == p.joints[i].first);
+    CHECK(back.joints.size() == p.joints.size());
+    for (std::size_t i = 0; i < p.joints.size(); ++i) CHECK(back.joints[i].first == p.joints[i].first);
   } catch (const profile_error& e) {
-    check(std::string_view(e.what()).substr(0, 9) == "fuzz.json");
+    CHECK(std::string_view(e.what()).substr(0, 9) == "fuzz.json");
+  } catch (const std::exception& e) {
+    check(false, e.what(), __LINE__);  // only a profile_error may leave
   } catch (...) {
-    check(false);
+    CHECK(false);
   }
   try {
     motion_file(text, khr);
+  } catch (const std::exception& e) {
+    check(false, e.what(), __LINE__);  // only a profile_error may leave
   } catch (...) {
-    check(false);
+    CHECK(false);
   }
   return 0;
 }

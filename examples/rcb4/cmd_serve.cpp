@@ -23,6 +23,7 @@ struct serve_options {
   long long servos = -1;
   std::vector<int> silent;
   int period_ms = 0;
+  std::string turn;  // ICS:MS, a hand turning a servo on a schedule
   rcb4::transport::serve_options serve;
   rcb4::board::options board;
 };
@@ -65,6 +66,18 @@ int serve(serve_options& o, const globals& g) {
     const auto address = boost::asio::ip::make_address(o.tcp.substr(0, colon), ec);
     if (ec) throw usage_error(fmt::format("--tcp: '{}' is not an IP address", o.tcp.substr(0, colon)));
     endpoint.emplace(address, static_cast<std::uint16_t>(port));
+  }
+
+  std::optional<std::pair<rcb4::ics_number, std::chrono::milliseconds>> turn;
+  if (!o.turn.empty()) {
+    const auto colon = o.turn.find(':');
+    if (colon == std::string::npos) throw usage_error(fmt::format("--turn: expected ICS:MS, not '{}'", o.turn));
+    const auto n = rcb4::ics_number::make(parse_int(std::string_view(o.turn).substr(0, colon), "--turn ICS", 0, 34));
+    if (!o.board.servos.contains(n.value()) || o.board.unanswered.contains(n.value()))
+      throw usage_error(
+          fmt::format("--turn {}: the board has no answering servo at ICS {}", o.turn, n.value().value()));
+    turn.emplace(n.value(), std::chrono::milliseconds(
+                                parse_int(std::string_view(o.turn).substr(colon + 1), "--turn MS", 1, 3'600'000)));
   }
 
   board::virtual_board board(o.board);
@@ -121,9 +134,37 @@ int serve(serve_options& o, const globals& g) {
     });
   };
   if (!o.rom_path.empty()) arm();
+
+  // --turn: a hand turns the servo 500 counts one way, then back, every MS; each turn is printed
+  // with its CLOCK_MONOTONIC time (steady_clock here, time.monotonic() in Python) for latency
+  // measurements: from the measured position changing to a program seeing it.
+  boost::asio::steady_timer hand(io);
+  auto next_turn = std::chrono::steady_clock::now();  // on a fixed grid: late wake-ups do not add up
+  bool turned = false;
+  std::uint16_t rest = 0;
+  std::function<void()> turn_next = [&] {
+    next_turn += turn->second;
+    hand.expires_at(next_turn);
+    hand.async_wait([&](const boost::system::error_code& ec) {
+      if (ec) return;
+      if (!turned) rest = board.ram16(*board.block_of(turn->first) + servo_block::position.offset);
+      const auto to = static_cast<std::uint16_t>(turned ? rest : rest + 500);
+      board.turn_by_hand(turn->first, to);
+      const double at = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+      turned = !turned;
+      if (g.json)
+        emit(json{{"turned", turn->first.value()}, {"to", to}, {"at", at}});
+      else
+        fmt::print("turned ICS {} to {} at {:.6f}\n", turn->first.value(), to, at);
+      std::fflush(stdout);
+      turn_next();
+    });
+  };
+  if (turn) turn_next();
   boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   signals.async_wait([&](const boost::system::error_code&, int) {
     saver.cancel();
+    hand.cancel();
     server->stop();
   });
   io.run();
@@ -169,6 +210,10 @@ void add_serve_command(CLI::App& app, context& ctx) {
       ->type_name("ICS,...")
       ->delimiter(',')
       ->check(int_range(0, 34));
+  cmd->add_option("--turn", o->turn,
+                  "turn servo ICS by hand every MS ms, 500 counts one way then back (a free servo stays where it is "
+                  "turned), each turn printed with its CLOCK_MONOTONIC time: for latency measurements")
+      ->type_name("ICS:MS");
   cmd->footer(
       "Serves an emulated RCB-4HV wired as the robot --robot names (default: a KHR-3HV, 20 servos,\n"
       "three demo motions) until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"

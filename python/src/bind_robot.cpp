@@ -60,11 +60,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
   cls.def(
          "capture",
          [](board& b) {
-           std::vector<std::optional<double>> a;
-           {
-             py::gil_scoped_release release;
-             a = b.angles();
-           }
+           const std::vector<std::optional<double>> a = unlocked([&] { return b.angles(); });
            py::dict d;
            for (std::size_t i = 0; i < a.size(); ++i)
              if (a[i]) d[py::str(b.robot().joints()[i].name)] = std::round(*a[i] * 100) / 100;
@@ -76,11 +72,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
           [](board& b, const py::object& pose, std::optional<double> time, bool wait) {
             auto [joints, file_time] = pose_of(b, pose);
             const double t = time.value_or(file_time.value_or(1.0));
-            double takes = 0;
-            {
-              py::gil_scoped_release release;
-              takes = b.move(joints, t);
-            }
+            const double takes = unlocked([&] { return b.move(joints, t); });
             if (wait) sleep_interruptible(takes);
             return takes;
           },
@@ -90,11 +82,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
       .def(
           "trims",
           [](board& b) {
-            std::vector<rcb4::robot::joint_reading> rs;
-            {
-              py::gil_scoped_release release;
-              rs = b.states();
-            }
+            const std::vector<rcb4::robot::joint_reading> rs = unlocked([&] { return b.states(); });
             py::dict d;
             for (const auto& r : rs)
               if (r.allocated) d[py::str(r.j->name)] = std::round(rcb4::robot::trim_degrees(*r.j, r.trim) * 100) / 100;
@@ -114,11 +102,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
       .def(
           "servos",
           [](board& b) {
-            std::vector<rcb4::robot::joint_reading> rs;
-            {
-              py::gil_scoped_release release;
-              rs = b.states();
-            }
+            const std::vector<rcb4::robot::joint_reading> rs = unlocked([&] { return b.states(); });
             py::dict d;
             for (const auto& r : rs)
               if (r.allocated)
@@ -132,11 +116,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
       .def(
           "scan",
           [](board& b) {
-            std::vector<rcb4::ops::slot_probe> ps;
-            {
-              py::gil_scoped_release release;
-              ps = b.scan();
-            }
+            const std::vector<rcb4::ops::slot_probe> ps = unlocked([&] { return b.scan(); });
             py::list out;
             for (const auto& p : ps) {
               const auto* j = b.robot().on(p.ics);
@@ -188,11 +168,7 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
       .def(
           "set_config",
           [](board& b, const py::kwargs& fields) {
-            rcb4::config_word c;
-            {
-              py::gil_scoped_release release;
-              c = b.config();
-            }
+            rcb4::config_word c = unlocked([&] { return b.config(); });
             for (const auto& [k, v] : fields) {
               const auto key = k.cast<std::string>();
               const auto flag = [&](bool& f) {

@@ -20,6 +20,13 @@ inline void check_signals() {
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
 }
 
+/** @p f() with the GIL released (the board's I/O lets other Python threads run), its result back. */
+template <class F>
+auto unlocked(F&& f) {
+  py::gil_scoped_release release;
+  return f();
+}
+
 /** Sleeps @p seconds with the GIL released, looking at signals every 50 ms. */
 inline void sleep_interruptible(double seconds) {
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(

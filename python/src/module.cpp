@@ -149,11 +149,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def_property_readonly(
           "config",
           [](board& b) {
-            rcb4::config_word c;
-            {
-              py::gil_scoped_release release;
-              c = b.config();
-            }
+            const rcb4::config_word c = unlocked([&] { return b.config(); });
             return config_dict(c);
           },
           "The config register at RAM 0x0000, decoded (a dict).")
@@ -200,22 +196,14 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def_property_readonly(
           "period",
           [](board& b) {
-            rcb4::config_word c;
-            {
-              py::gil_scoped_release release;
-              c = b.config();
-            }
+            const rcb4::config_word c = unlocked([&] { return b.config(); });
             return rcb4::milliseconds(c.period) / 1000.0;
           },
           "The board's output period in seconds (one interpolation frame).")
       .def(
           "joints",
           [](board& b) {
-            std::vector<std::optional<double>> a;
-            {
-              py::gil_scoped_release release;
-              a = b.angles();
-            }
+            const std::vector<std::optional<double>> a = unlocked([&] { return b.angles(); });
             py::dict d;
             for (std::size_t i = 0; i < a.size(); ++i)
               d[py::str(b.robot().joints()[i].name)] = a[i] ? py::object(py::float_(*a[i])) : py::object(py::none());
@@ -225,11 +213,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def(
           "angle_vector",
           [](board& b) {
-            std::vector<std::optional<double>> a;
-            {
-              py::gil_scoped_release release;
-              a = b.angles();
-            }
+            const std::vector<std::optional<double>> a = unlocked([&] { return b.angles(); });
             py::array_t<double> out(static_cast<py::ssize_t>(a.size()));
             auto w = out.mutable_unchecked<1>();
             for (std::size_t i = 0; i < a.size(); ++i)
@@ -251,11 +235,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
               }
               ts.emplace_back(k.cast<std::string>(), d);
             }
-            double takes = 0;
-            {
-              py::gil_scoped_release release;
-              takes = b.move(ts, time);
-            }
+            const double takes = unlocked([&] { return b.move(ts, time); });
             if (wait) sleep_interruptible(takes);
             return takes;
           },
@@ -300,11 +280,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def(
           "motion_status",
           [](board& b) {
-            motion_status st;
-            {
-              py::gil_scoped_release release;
-              st = b.motion();
-            }
+            const motion_status st = unlocked([&] { return b.motion(); });
             return status_dict(st);
           },
           "Whether a motion runs: running, suspended, motion (or None), program_counter.")
@@ -325,11 +301,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def(
           "motions",
           [](board& b) {
-            std::vector<rcb4::ops::motion_slot> v;
-            {
-              py::gil_scoped_release release;
-              v = b.motions();
-            }
+            const std::vector<rcb4::ops::motion_slot> v = unlocked([&] { return b.motions(); });
             py::list out;
             for (const auto& s : v) {
               const auto name = b.robot().motion(s.number);
@@ -344,11 +316,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def(
           "sensors",
           [](board& b) {
-            sensor_reading s;
-            {
-              py::gil_scoped_release release;
-              s = b.sensors();
-            }
+            const sensor_reading s = unlocked([&] { return b.sensors(); });
             std::vector<double> volts;
             for (const auto v : s.ad) volts.push_back(std::round(v * 5.0 / 1024 * 1000) / 1000);
             return py::dict("battery_volts"_a = s.battery_volts, "ad"_a = s.ad, "ad_volts"_a = volts,

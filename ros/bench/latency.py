@@ -1,46 +1,34 @@
 #!/usr/bin/env python3
 # From a servo's measured position changing on the board to the joint_states message that carries
 # it: latency (median, p99) and the achieved joint_states rate, next to the board's output period.
-# The board is the Python stand-in of tests/integration (an RCB-4 written from protocol.md), paced
-# as a 1.25 Mbaud line with 0 and 1,000 us of adapter latency, so that this script can change a
-# servo's measured position itself at a known moment (rcb4 serve's servos move only when told).
+# The board is `rcb4 serve --pty --pace` (a KHR-3HV's 20 servos; replies at the 1.25 Mbaud line's
+# pace, plus 0 or 1,000 us of adapter latency) with `--turn 0:MS`: a hand turns head_yaw (ICS 0)
+# 500 counts and back every MS ms and the server prints each turn's CLOCK_MONOTONIC time, which is
+# time.monotonic() here. Latency = the first joint_states message carrying the new position minus
+# that time.
 #   latency.py RCB4_TOOL PYRCB4_DIR NODE_SRC_DIR [SAMPLES]
 # SPDX-License-Identifier: BSL-1.0
+import math
 import os
-import random
 import signal
-import socket
 import statistics
 import subprocess
 import sys
-import tempfile
+import threading
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tests", "integration"))
-from standin import StandIn  # noqa: E402
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tests"))
+import master as rosmaster  # noqa: E402 (ros/tests/master.py)
 
 TOOL, PYRCB4, NODE_SRC = sys.argv[1:4]
 SAMPLES = int(sys.argv[4]) if len(sys.argv) > 4 else 100
 PERIOD_MS = 10  # the board's output period: a rate above 100 Hz only repeats data
+TURN_MS = 37    # not a multiple of the period or of the node's cycle: turns fall at every phase
 
-with socket.socket() as s:
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=tempfile.mkdtemp(prefix="rcb4-ros-"),
-           PYTHONPATH=os.pathsep.join([PYRCB4, NODE_SRC]))
-os.environ.update(env)
-master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-import rosgraph  # noqa: E402
+master, env = rosmaster.start(PYRCB4, NODE_SRC, "/bench")
 import rospy  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
-for _ in range(100):
-    try:
-        rosgraph.Master("/bench").getPid()
-        break
-    except Exception:  # noqa: BLE001
-        time.sleep(0.1)
 rospy.init_node("rcb4_latency", anonymous=True, disable_signals=True)
 seen = []  # (monotonic arrival, head_yaw position in radians)
 rospy.Subscriber("/joint_states", JointState,
@@ -48,42 +36,46 @@ rospy.Subscriber("/joint_states", JointState,
                  if "head_yaw" in m.name else None, queue_size=1000)
 
 
-def head_at(board, counts):
-    board.ram[0x90 + 4:0x90 + 6] = counts.to_bytes(2, "little")
-
-
-print(f"position change -> joint_states, {SAMPLES} changes, a 1.25 Mbaud line; board output period {PERIOD_MS} ms")
+print(f"position change -> joint_states, {SAMPLES} changes, rcb4 serve --pace at 1.25 Mbaud; "
+      f"board output period {PERIOD_MS} ms")
 print(f"{'adapter latency':>16} {'rate':>9} {'median':>9} {'p99':>9}")
+COUNTS_PER_RAD = 8000 / 270 * 180 / math.pi  # KHR-3HV: 270 degrees over counts 3500..11500
 try:
     for latency in (0, 1000):
-        board = StandIn(pace_baud=1250000, latency_us=latency)
-        head_at(board, 7500)
+        srv = subprocess.Popen([TOOL, "serve", "--pty", "--pace", "--latency", str(latency), "--turn", f"0:{TURN_MS}"],
+                               stdout=subprocess.PIPE, text=True)
+        device = srv.stdout.readline().strip()
+        turns = []  # (monotonic time, counts)
+        threading.Thread(target=lambda: [turns.append((float(w[-1]), int(w[-3])))
+                                         for w in (line.split() for line in srv.stdout) if w and w[0] == "turned"],
+                         daemon=True).start()
         node = subprocess.Popen([sys.executable, os.path.join(NODE_SRC, "..", "scripts", "rcb4_node"),
-                                 f"_device:={board.path}", "_baud:=1250000", "_rate:=1000"], env=env,
+                                 f"_device:={device}", "_baud:=1250000", "_rate:=1000"], env=env,
                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        while len(seen) < 20:
+        while len(seen) < 20 or not turns:
             time.sleep(0.05)
         seen.clear()
+        done = len(turns)
         start = time.monotonic()
-        lags, value = [], 7500
-        for _ in range(SAMPLES):
-            time.sleep(random.uniform(0.02, 0.05))  # at a random phase of the node's cycle
-            value = 8000 if value == 7500 else 7500
-            changed = time.monotonic()
-            head_at(board, value)
-            want = (value - 7500) / (8000 / 270) * 3.141592653589793 / 180
-            while True:
-                hit = [t for t, p in list(seen) if t >= changed and abs(p - want) < 1e-3]
-                if hit:
-                    lags.append(hit[0] - changed)
-                    break
-                time.sleep(0.0005)
+        while len(turns) < done + SAMPLES + 1:
+            time.sleep(0.05)
+        time.sleep(0.1)
+        lags = []
+        for at, counts in turns[done:done + SAMPLES]:
+            want = (counts - 7500) / COUNTS_PER_RAD  # the built-in profile: head_yaw 0 at 7500, no trim
+            hit = [t for t, p in list(seen) if t >= at and abs(p - want) < 2 / COUNTS_PER_RAD]
+            if hit:
+                lags.append(hit[0] - at)
         rate = len([t for t, _ in seen if t >= start]) / (time.monotonic() - start)
+        node.send_signal(signal.SIGINT)
+        node.wait(timeout=10)
+        srv.send_signal(signal.SIGINT)
+        srv.wait(timeout=10)
+        if len(lags) < SAMPLES:
+            sys.exit(f"only {len(lags)} of {SAMPLES} turns reached joint_states")
         lags.sort()
         print(f"{latency:>13} us {rate:>7.1f}/s {statistics.median(lags) * 1000:>7.2f} ms "
               f"{lags[int(0.99 * (len(lags) - 1))] * 1000:>7.2f} ms")
-        node.send_signal(signal.SIGINT)
-        node.wait(timeout=10)
         seen.clear()
 finally:
     rospy.signal_shutdown("done")

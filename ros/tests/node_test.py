@@ -10,29 +10,21 @@ import json
 import math
 import os
 import signal
-import socket
 import subprocess
 import sys
-import tempfile
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.join(HERE, "..", "..", "tests", "integration"))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "tests", "integration")]
 from checks import check, finish  # noqa: E402
+import master as rosmaster  # noqa: E402 (ros/tests/master.py)
 from standin import StandIn  # noqa: E402
 
 RCB4, PYRCB4, NODE_SRC = sys.argv[1], sys.argv[2], sys.argv[3]
 NODE = os.path.join(NODE_SRC, "..", "scripts", "rcb4_node")
 
-with socket.socket() as s:
-    s.bind(("127.0.0.1", 0))
-    port = s.getsockname()[1]
-env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=tempfile.mkdtemp(prefix="rcb4-ros-"),
-           PYTHONPATH=os.pathsep.join([PYRCB4, NODE_SRC, os.environ.get("PYTHONPATH", "")]))
-os.environ.update(env)
-master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+master, env = rosmaster.start(PYRCB4, NODE_SRC)
 
-import rosgraph  # noqa: E402
 import rospy  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
 from sensor_msgs.msg import BatteryState, JointState  # noqa: E402
@@ -40,12 +32,6 @@ from std_msgs.msg import String, UInt8  # noqa: E402
 from std_srvs.srv import Trigger  # noqa: E402
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E402
 
-for _ in range(100):
-    try:
-        rosgraph.Master("/rcb4_test").getPid()
-        break
-    except Exception:  # noqa: BLE001 (not up yet)
-        time.sleep(0.1)
 rospy.init_node("rcb4_test", anonymous=True, disable_signals=True)
 
 states, diags = [], []
@@ -147,6 +133,15 @@ try:
     check(abs(last_position("head_yaw") - 60) < 0.5, f"a trajectory while motion 3 runs moves nothing ({last_position('head_yaw')})")
     wait_for(lambda: "running\": false" in (rospy.wait_for_message("/rcb4/motion", String, timeout=5).data), timeout=10)
     trajectory([(35, 0.2)])
+    wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
+    # A segment longer than one board move (255 periods, 2.55 s): 3 s up to 75 degrees, split into
+    # moves along the same line, halfway at 1.5 s; then back to 35.
+    trajectory([(75, 3.0), (35, 3.3)])
+    time.sleep(1.5)
+    half = last_position("left_knee")
+    check(45 < half < 65, f"a 3 s segment is halfway (55 deg) at 1.5 s ({half})")
+    check(wait_for(lambda: last_position("left_knee") > 74, timeout=5) is not None,
+          f"a 3 s segment (more than 255 periods) reaches its point, within 1 deg ({last_position('left_knee')})")
     wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
 
     free = rospy.ServiceProxy("/rcb4/free", Trigger)

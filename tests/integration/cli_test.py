@@ -444,6 +444,27 @@ p15.terminate()
 p15.wait(timeout=10)
 expect_rc(["serve", "--pty", "--period", "12"], 2, "--period")
 
+# serve --turn: a hand turns head_yaw (ICS 0, free at boot) 500 counts and back every 100 ms, each
+# turn printed with its CLOCK_MONOTONIC time (time.monotonic() here); the board shows the position.
+hand = subprocess.Popen([RCB4, "serve", "--pty", "--turn", "0:100"], stdout=subprocess.PIPE, text=True)
+hand_path = hand.stdout.readline().strip()
+t0 = time.monotonic()
+first, second = hand.stdout.readline().split(), hand.stdout.readline().split()
+check(first[:3] == ["turned", "ICS", "0"] and second[:3] == ["turned", "ICS", "0"]
+      and int(first[4]) == int(second[4]) + 500 and t0 <= float(first[6]) < float(second[6]) <= time.monotonic()
+      and abs(float(second[6]) - float(first[6]) - 0.1) < 0.05,
+      f"serve --turn 0:100: 500 counts one way, then back, 100 ms apart, at monotonic times ({first}, {second})")
+rc, out, err = run("--json", "--device", hand_path, "servo", "get", "0")
+now_at = hand.stdout.readline().split()  # the turn after the read: the read saw the one before it
+check(rc == 0 and json.loads(out)[0]["position"] in (int(first[4]), int(second[4])),
+      f"the board shows the turned position ({out.strip()[:100]!r}, {now_at})")
+hand.send_signal(signal.SIGINT)
+check(hand.wait(timeout=10) == 0, f"serve --turn ends at SIGINT with 0 ({hand.returncode})")
+expect_rc(["serve", "--pty", "--turn", "40:100"], 2, "--turn ICS")
+expect_rc(["serve", "--pty", "--turn", "0"], 2, "expected ICS:MS")
+expect_rc(["serve", "--pty", "--turn", "3:0"], 2, "--turn MS")
+expect_rc(["serve", "--pty", "--silent", "3", "--turn", "3:100"], 2, "no answering servo at ICS 3")
+
 # monitor faster than the link: says so once on stderr, every line still whole JSON.
 paced = subprocess.Popen([RCB4, "serve", "--pty", "--pace", "--latency", "1000"], stdout=subprocess.PIPE, text=True)
 rc, out, err = run("--json", "--device", paced.stdout.readline().strip(), "--baud", "1250000", "monitor", "--hz", "1000",

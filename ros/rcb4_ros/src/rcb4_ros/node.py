@@ -98,18 +98,15 @@ class Rcb4Node:
                 self.trajectory = []
             return
         try:
-            points, start, last = [], 0.0, 0.0
+            points, last = [], 0.0
+            before = self.angles.copy()  # where the first segment starts: the joints as last read
             for k, p in enumerate(msg.points):
                 targets = self.degrees_of(msg.joint_names, p.positions, f"point {k}")
                 t = p.time_from_start.to_sec()
                 if t < last:
                     raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
-                frames = round((t - last) / self.period)
-                if frames > 255:
-                    raise ValueError(f"point {k}: {t - last:.3f} s from the one before is more than a move takes "
-                                     f"(255 periods of {self.period * 1000:.0f} ms)")
-                points.append((last, targets, max(frames, 1) if t > last else 0))
-                last = t
+                points += self.segment(last, t, before, targets)
+                before, last = targets, t
         except ValueError as e:
             rospy.logerr_throttle(1.0, f"rcb4: trajectory refused, nothing moves: {e}")
             return
@@ -118,6 +115,22 @@ class Rcb4Node:
         with self.lock:  # a newer trajectory replaces what is left of the old one
             self.trajectory = [(begin + at, targets, frames) for at, targets, frames in points]
             self.stream = None
+
+    def segment(self, t0, t1, before, targets):
+        """The moves that take the joints from @p before (degrees at t0) to @p targets at t1:
+        [(start time, targets, frames)]. A move lasts at most 255 board periods, so a longer segment
+        becomes equal moves along the same straight line, as the board interpolates it (a joint
+        whose start is unknown, NaN, moves in the last of them only)."""
+        frames = round((t1 - t0) / self.period)
+        if t1 <= t0:
+            return [(t0, targets, 0)]
+        pieces = max(1, math.ceil(frames / 255))
+        moves = []
+        for j in range(1, pieces + 1):
+            at = targets if j == pieces else before + (targets - before) * (j / pieces)
+            n = max(1, round(frames * j / pieces) - round(frames * (j - 1) / pieces))
+            moves.append((t0 + (t1 - t0) * (j - 1) / pieces, at, n))
+        return moves
 
     def on_joint_command(self, msg):
         try:
