@@ -138,8 +138,10 @@ pose parse_pose_nodes(std::string_view text, const std::string& source, const mo
   if (!root.IsMap()) throw profile_error(source, "a pose is a mapping with robot, joints and optionally time_ms");
   check_keys(source, root, {"robot", "joints", "time_ms"}, "pose");
   pose p;
+  p.robot = m.name();  // a pose that names no robot is the profile's (and is written back so)
   if (root["robot"]) {
     p.robot = scalar(source, root["robot"], "robot");
+    if (p.robot.empty()) fail(source, root["robot"], "robot: an empty name (name " + m.name() + " or leave it out)");
     // Another robot's pose may name the same joints with other zeros, directions and limits.
     // Names compare without case: "khr-3hv" (the built-in's name) is KHR-3HV.
     const auto same = [](std::string_view a, std::string_view b) {
@@ -180,7 +182,7 @@ double hundredths(double d) {
 
 std::string pose_json(const pose& p) {
   nlohmann::ordered_json j;
-  j["robot"] = p.robot;
+  if (!p.robot.empty()) j["robot"] = p.robot;  // a pose built without one names no robot
   if (p.time) j["time_ms"] = p.time->count();
   nlohmann::ordered_json joints = nlohmann::ordered_json::object();
   for (const auto& [n, d] : p.joints) joints[n] = hundredths(d);
@@ -191,7 +193,8 @@ std::string pose_json(const pose& p) {
 
 std::string pose_yaml(const pose& p) {
   YAML::Emitter out;
-  out << YAML::BeginMap << YAML::Key << "robot" << YAML::Value << p.robot;
+  out << YAML::BeginMap;
+  if (!p.robot.empty()) out << YAML::Key << "robot" << YAML::Value << p.robot;
   if (p.time) out << YAML::Key << "time_ms" << YAML::Value << p.time->count();
   out << YAML::Key << "joints" << YAML::Value << YAML::BeginMap;
   // Six significant digits: ±360.00 at most, written as 39.99, not 39.990000000000002.

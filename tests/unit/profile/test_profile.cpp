@@ -146,6 +146,20 @@ TEST_CASE("profile: poses in JSON and YAML, written and read back", "[profile]")
                     "p.yaml:1:8: this pose is KXR-L2's, not test's (--robot names the profile it was captured with)");
   // The same robot in other letters is the same robot.
   CHECK(parse_pose("robot: TEST\njoints: {left_knee: 10}\n", "p.yaml", m).joints.size() == 1);
+  // A pose that names no robot is the profile's, and is written back naming it (found by fuzzing:
+  // it was written back as "robot": "", which did not read). An empty name is refused, saying so.
+  const auto unnamed = parse_pose("{\"joints\": {\"left_knee\": 10}}", "p.json", m);
+  CHECK(unnamed.robot == "test");
+  CHECK(pose_json(unnamed) == "{\n  \"robot\": \"test\",\n  \"joints\": {\n    \"left_knee\": 10.0\n  }\n}\n");
+  CHECK(parse_pose(pose_json(unnamed), "back.json", m).joints.size() == 1);
+  CHECK(parse_pose(pose_yaml(unnamed), "back.yaml", m).joints.size() == 1);
+  CHECK_THROWS_WITH(parse_pose("robot: ''\njoints: {left_knee: 10}\n", "p.yaml", m),
+                    "p.yaml:1:8: robot: an empty name (name test or leave it out)");
+  // A pose built in code without a robot is written without one, and reads back.
+  const pose anonymous{"", {{"left_knee", 5}}, std::nullopt};
+  CHECK(pose_json(anonymous).find("robot") == std::string::npos);
+  CHECK(pose_yaml(anonymous).find("robot") == std::string::npos);
+  CHECK(parse_pose(pose_yaml(anonymous), "back.yaml", m).joints.size() == 1);
 }
 
 TEST_CASE("profile: YAML poses carry hundredths, not float noise", "[profile]") {

@@ -48,7 +48,7 @@ model open_profile(std::string_view what);
 
 /** Joint angles in degrees, by name, in the order given. */
 struct pose {
-  std::string robot;                                   ///< the profile's robot name (informative)
+  std::string robot;  ///< its robot: the file's, else the profile's name (empty: none, not written)
   std::vector<std::pair<std::string, double>> joints;  ///< name → degrees
   std::optional<std::chrono::milliseconds> time;       ///< how long playing it takes, when the file says
 };
