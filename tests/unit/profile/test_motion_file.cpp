@@ -197,6 +197,21 @@ TEST_CASE("motion file: times are frames of the period the file names, rescaled 
             .find("at most 255 (3825 ms)") != std::string::npos);
 }
 
+TEST_CASE("motion file: a step after an end or a goto is noted as never running", "[motion_file]") {
+  // The habit of ending every file with end, after a loop that jumps back for ever (found by
+  // fuzzing: such an end is written, but a pull follows the code and does not show it).
+  const auto d = parse_motion(with_steps("  - label: top\n  - pose: {left_knee: 30}\n    time_ms: 300\n"
+                                         "  - goto: top\n  - end\n  - label: more\n  - end\n"),
+                              "m.yaml", khr());
+  const auto c = to_program(d, khr(), hth4_2_2, output_period::ms15);
+  REQUIRE(ok(c));
+  const auto& notes = std::get<compiled_motion>(c).notes;
+  REQUIRE(notes.size() == 1);  // the end after the goto; the label after the end starts reachable code
+  CHECK(notes[0].find("step 4 (m.yaml:") == 0);
+  CHECK(notes[0].find("never runs: the step before it always jumps away") != std::string::npos);
+  CHECK(std::get<compiled_motion>(c).program.steps.size() == 6);  // still written as the file says
+}
+
 TEST_CASE("motion file: pose files are read beside the motion file", "[motion_file]") {
   const auto dir = temp_dir();
   {
