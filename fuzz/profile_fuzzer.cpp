@@ -85,28 +85,25 @@ void motion_file(std::string_view text, const rcb4::robot::model& khr) {
   const auto b = rcb4::motion::assemble(std::get<compiled_motion>(c).program, where);
   if (!rcb4::motion::ok(b)) return;
   const auto& bytes = std::get<std::vector<std::uint8_t>>(b);
-  const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where));
-  CHECK(rcb4::motion::ok(p));
-  const auto back = to_program(from_program(std::get<rcb4::motion::program>(p), khr, rcb4::hth4_2_2, d.period), khr,
+  // Read back as pull does (disassemble, lift, from_program) and assembled again. A pose of a joint
+  // beyond its limit cannot come out of to_program: the same limits pass again.
+  const auto read_back = [&](const std::vector<std::uint8_t>& x) {
+    const auto p = rcb4::motion::lift(rcb4::motion::disassemble(x, where));
+    CHECK(rcb4::motion::ok(p));
+    const auto c2 = to_program(from_program(std::get<rcb4::motion::program>(p), khr, rcb4::hth4_2_2, d.period), khr,
                                rcb4::hth4_2_2, d.period);
-  // A pose of a joint beyond its limit cannot come out of to_program: the same limits pass again.
-  CHECK(ok(back));
-  const auto b2 = rcb4::motion::assemble(std::get<compiled_motion>(back).program, where);
-  CHECK(rcb4::motion::ok(b2));
-  const auto& bytes2 = std::get<std::vector<std::uint8_t>>(b2);
+    CHECK(ok(c2));
+    const auto b2 = rcb4::motion::assemble(std::get<compiled_motion>(c2).program, where);
+    CHECK(rcb4::motion::ok(b2));
+    return std::get<std::vector<std::uint8_t>>(b2);
+  };
+  const auto bytes2 = read_back(bytes);
   // The same bytes when the code reaches all of them; a step no code reaches (after an end or a
   // goto) is not read back, so then the bytes read back must read back to themselves.
-  if (reached(bytes, where) == bytes.size()) {
+  if (reached(bytes, where) == bytes.size())
     CHECK(bytes2 == bytes);
-  } else {
-    const auto p2 = rcb4::motion::lift(rcb4::motion::disassemble(bytes2, where));
-    CHECK(rcb4::motion::ok(p2));
-    const auto c3 = to_program(from_program(std::get<rcb4::motion::program>(p2), khr, rcb4::hth4_2_2, d.period), khr,
-                               rcb4::hth4_2_2, d.period);
-    CHECK(ok(c3));
-    const auto b3 = rcb4::motion::assemble(std::get<compiled_motion>(c3).program, where);
-    CHECK(rcb4::motion::ok(b3) && std::get<std::vector<std::uint8_t>>(b3) == bytes2);
-  }
+  else
+    CHECK(read_back(bytes2) == bytes2);
 }
 }  // namespace
 
