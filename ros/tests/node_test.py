@@ -119,6 +119,14 @@ try:
     time.sleep(0.3)
     check(5 < last_position("head_yaw") < 45, f"a joint_command for left_knee does not make head_yaw jump ({last_position('head_yaw')})")
     wait_for(lambda: abs(last_position("head_yaw") - 60) < 0.5, timeout=5)
+    # A streamed command for left_knee leaves the rest of head_yaw's trajectory (30, then 60) to it.
+    t.points = [JointTrajectoryPoint(positions=[math.radians(30)], time_from_start=rospy.Duration(0.5)),
+                JointTrajectoryPoint(positions=[math.radians(60)], time_from_start=rospy.Duration(1.0))]
+    cmd.publish(t)
+    time.sleep(0.3)
+    stream.publish(JointState(name=["left_knee"], position=[math.radians(35)]))
+    check(wait_for(lambda: abs(last_position("head_yaw") - 60) < 0.5 and time.monotonic(), timeout=5) is not None,
+          f"a joint_command for left_knee leaves head_yaw's next point to its trajectory ({last_position('head_yaw')})")
     battery = rospy.wait_for_message("/rcb4/battery", BatteryState, timeout=5)
     check(battery.voltage > 5 and math.isnan(battery.percentage) and math.isnan(battery.current),
           f"~battery: volts, and NaN for what the board does not measure ({battery.voltage}, {battery.percentage})")

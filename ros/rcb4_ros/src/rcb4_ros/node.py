@@ -28,7 +28,12 @@ class Rcb4Node:
         self.device = rospy.get_param("~device", "") or None
         self.baud = int(rospy.get_param("~baud", 0)) or None
         self.robot = rospy.get_param("~robot", "khr-3hv")
-        self.timeout = float(rospy.get_param("~timeout", 0.1))
+        try:
+            self.timeout = float(rospy.get_param("~timeout", 0.1))
+        except (TypeError, ValueError):
+            raise ValueError(f"~timeout: {rospy.get_param('~timeout')!r} is not a number of seconds") from None
+        if self.device is None:
+            rospy.logwarn("rcb4: no ~device given: the in-process virtual board, a simulation, not a robot")
         self.prefix = rospy.get_param("~joint_prefix", "")
         self.board = pyrcb4.Board(self.device, baud=self.baud, robot=self.robot, timeout=self.timeout)
         self.period = self.board.period
@@ -39,6 +44,8 @@ class Rcb4Node:
         if not 0 < self.rate <= 1000:
             raise ValueError(f"~rate: {self.rate:g} Hz: it must be above 0 and at most 1000")
         self.reopen_at = None  # when the device went away: the next time to open it again
+        self.released = False  # the dead device closed, a new one not yet open
+        self.where = self.board.where
         self.stopping = threading.Event()  # SIGINT/SIGTERM: the loop ends, the board is let go
         self.names = self.board.joint_names
         self.limits = self.board.joint_limits
@@ -61,13 +68,13 @@ class Rcb4Node:
         self.diag_pub = rospy.Publisher("diagnostics", DiagnosticArray, queue_size=2)
         rospy.Subscriber("~command", JointTrajectory, self.on_trajectory, queue_size=2)
         rospy.Subscriber("~joint_command", JointState, self.on_joint_command, queue_size=1)
-        rospy.Subscriber("~free_joints", String, lambda m: self.queue("free", m.data), queue_size=5)
-        rospy.Subscriber("~hold_joints", String, lambda m: self.queue("hold", m.data), queue_size=5)
+        rospy.Subscriber("~free_joints", String, lambda m: self.some_joints("free", m.data), queue_size=5)
+        rospy.Subscriber("~hold_joints", String, lambda m: self.some_joints("hold", m.data), queue_size=5)
         rospy.Subscriber("~play_motion", UInt8, lambda m: self.queue("play", m.data), queue_size=5)
         rospy.Service("~free", Trigger, lambda r: self.trigger("free", ""))
         rospy.Service("~hold", Trigger, lambda r: self.trigger("hold", ""))
         rospy.Service("~stop_motion", Trigger, lambda r: self.trigger("stop", None))
-        rospy.loginfo("rcb4: %s, %d joints, %.0f Hz (output period %.0f ms)", self.board.where, len(self.names),
+        rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.board.where, len(self.names),
                       self.rate, self.period * 1000)
 
     # --- callbacks: check, queue, never touch the line ----------------------------------------------
@@ -140,7 +147,23 @@ class Rcb4Node:
             return
         with self.lock:
             self.stream = targets
-            self.trajectory = []
+            # The joints it names leave the trajectory under way; the others go on with it.
+            named = ~numpy.isnan(targets)
+            rest = []
+            for at, t, frames in self.trajectory:
+                t = t.copy()
+                t[named] = numpy.nan
+                if not numpy.isnan(t).all():
+                    rest.append((at, t, frames))
+            self.trajectory = rest
+
+    def some_joints(self, what, names):
+        """~free_joints / ~hold_joints: an empty message names nothing (~free and ~hold are for all)."""
+        if not names.replace(",", " ").split():
+            rospy.logerr_throttle(1.0, f"rcb4: ~{what}_joints: the message names no joint, so nothing was done "
+                                       f"(~{what} is for every joint)")
+            return
+        self.queue(what, names)
 
     def queue(self, what, argument, reply=None):
         self.requests.put((what, argument, reply))
@@ -174,8 +197,8 @@ class Rcb4Node:
                     self.board.stop_motion()
                     message = "motion stopped"
             except pyrcb4.Error as e:
-                ok, message = False, str(e)
-                rospy.logerr("rcb4: %s: %s", what, e)
+                ok, message = False, str(e) if str(e).startswith(what + ":") else f"{what}: {e}"
+                rospy.logerr("rcb4: %s", message)
             if reply:
                 reply[1].update(ok=ok, message=message)
                 reply[0].set()
@@ -196,7 +219,12 @@ class Rcb4Node:
                 self.trajectory = []
             return
         if due:
-            self.loop.write(due[1], frames=due[2])
+            # Points due in the same cycle (denser than the rate, or a late cycle): the last one, over
+            # what is left of its time, so the joints do not hurry and then wait.
+            at, targets, frames = due
+            if frames > 0:
+                frames = max(1, round((at + frames * self.period - now) / self.period))
+            self.loop.write(targets, frames=min(frames, 255))
         elif stream is not None:
             self.loop.write(stream, frames=max(1, round(1.0 / self.rate / self.period)))
 
@@ -238,13 +266,17 @@ class Rcb4Node:
 
     def reopen(self):
         self.reopen_at = time.monotonic() + 1.0
+        if not self.released:
+            # Let the dead device go first: while it is held open, the kernel cannot give its name
+            # (/dev/ttyUSB0, /dev/pts/N) to the adapter plugged in again.
+            self.board.close()
+            self.released = True
         try:
             board = pyrcb4.Board(self.device, baud=self.baud, robot=self.robot, timeout=self.timeout)
         except pyrcb4.Error as e:
             self.link_reason = f"{self.device} cannot be opened again: {e}"
             return
-        old, self.board = self.board, board
-        old.close()
+        self.board, self.released, self.where = board, False, board.where
         self.loop = self.board.control_loop()
         self.reopen_at = None
         rospy.loginfo("rcb4: %s opened again", self.device)
@@ -257,7 +289,7 @@ class Rcb4Node:
             self.rate_window = (now, self.cycles)
         st = DiagnosticStatus()
         st.name = "rcb4: link"
-        st.hardware_id = self.board.where
+        st.hardware_id = self.where
         missing = [self.prefix + n for n, d in zip(self.names, self.angles) if math.isnan(d)]
         if not self.link_ok:
             st.level, st.message = DiagnosticStatus.ERROR, f"the board does not answer: {self.link_reason}"
@@ -280,6 +312,8 @@ class Rcb4Node:
         try:
             while not (rospy.is_shutdown() or self.stopping.is_set()):
                 try:
+                    if self.released:
+                        raise pyrcb4.DeviceError(self.link_reason)
                     self.cycle()
                     if not self.link_ok:
                         rospy.loginfo("rcb4: the board answers again")
@@ -310,7 +344,8 @@ class Rcb4Node:
                     time.sleep(min(delay, 0.05))  # wakes for shutdown within 50 ms
                     delay = next_cycle - time.monotonic()
         finally:
-            self.board.close()
+            if not self.released:
+                self.board.close()
 
 
 def main():
