@@ -72,12 +72,12 @@ int serve(serve_options& o, const globals& g) {
   if (!o.turn.empty()) {
     const auto colon = o.turn.find(':');
     if (colon == std::string::npos) throw usage_error(fmt::format("--turn: expected ICS:MS, not '{}'", o.turn));
-    const auto n = rcb4::ics_number::make(parse_int(std::string_view(o.turn).substr(0, colon), "--turn ICS", 0, 34));
-    if (!o.board.servos.contains(n.value()) || o.board.unanswered.contains(n.value()))
-      throw usage_error(
-          fmt::format("--turn {}: the board has no answering servo at ICS {}", o.turn, n.value().value()));
-    turn.emplace(n.value(), std::chrono::milliseconds(
-                                parse_int(std::string_view(o.turn).substr(colon + 1), "--turn MS", 1, 3'600'000)));
+    const auto n =
+        rcb4::ics_number::make(parse_int(std::string_view(o.turn).substr(0, colon), "--turn ICS", 0, 34)).value();
+    if (!o.board.servos.contains(n) || o.board.unanswered.contains(n))
+      throw usage_error(fmt::format("--turn {}: the board has no answering servo at ICS {}", o.turn, n.value()));
+    turn.emplace(
+        n, std::chrono::milliseconds(parse_int(std::string_view(o.turn).substr(colon + 1), "--turn MS", 1, 3'600'000)));
   }
 
   board::virtual_board board(o.board);

@@ -437,13 +437,13 @@ outcome<compiled_motion> to_program(const motion_document& d, const model& m, co
   // A step after an end or an unconditional goto, with no label between, never runs: it is
   // assembled as written, but the board never gets there and a pull (which follows the code) will
   // not show it.
-  for (std::size_t i = 1; i < d.steps.size(); ++i)
-    if ((std::holds_alternative<motion::end>(d.steps[i - 1]) ||
-         std::holds_alternative<motion::go_to>(d.steps[i - 1])) &&
+  for (std::size_t i = 1; i < d.steps.size(); ++i) {
+    const bool returns = std::holds_alternative<motion::end>(d.steps[i - 1]);
+    if ((returns || std::holds_alternative<motion::go_to>(d.steps[i - 1])) &&
         !std::holds_alternative<motion::label>(d.steps[i]))
-      out.notes.push_back(at(i) + "never runs: the step before it always " +
-                          (std::holds_alternative<motion::end>(d.steps[i - 1]) ? "returns" : "jumps away") +
+      out.notes.push_back(at(i) + "never runs: the step before it always " + (returns ? "returns" : "jumps away") +
                           " (it is written, but a pull will not show it)");
+  }
   for (std::size_t i = 0; i < d.steps.size(); ++i) {
     const auto& s = d.steps[i];
     const auto target = [&](const std::string& to) -> std::optional<problem> {

@@ -125,7 +125,7 @@ try:
     cmd.publish(t)
     time.sleep(0.3)
     stream.publish(JointState(name=["left_knee"], position=[math.radians(35)]))
-    check(wait_for(lambda: abs(last_position("head_yaw") - 60) < 0.5 and time.monotonic(), timeout=5) is not None,
+    check(wait_for(lambda: abs(last_position("head_yaw") - 60) < 0.5, timeout=5) is not None,
           f"a joint_command for left_knee leaves head_yaw's next point to its trajectory ({last_position('head_yaw')})")
     battery = rospy.wait_for_message("/rcb4/battery", BatteryState, timeout=5)
     check(battery.voltage > 5 and math.isnan(battery.percentage) and math.isnan(battery.current),
@@ -152,6 +152,11 @@ try:
           f"a 3 s segment (more than 255 periods) reaches its point, within 1 deg ({last_position('left_knee')})")
     wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
 
+    # An empty ~free_joints names nothing: it frees nothing (a robot would fall), and says so.
+    free_joints = rospy.Publisher("/rcb4/free_joints", String, queue_size=2)
+    wait_for(lambda: free_joints.get_num_connections() > 0)
+    free_joints.publish(String(" "))
+    time.sleep(0.3)
     free = rospy.ServiceProxy("/rcb4/free", Trigger)
     hold = rospy.ServiceProxy("/rcb4/hold", Trigger)
     r1, r2 = hold(), free()
@@ -161,6 +166,7 @@ try:
     check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
     check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
     check("motion 3 is running on the board" in out, "the trajectory refused under motion 3 is logged")
+    check("~free_joints: the message names no joint, so nothing was done" in out, "an empty ~free_joints is refused, logged")
     j = tool_joints(dev)
     check(j and abs(j["left_knee"]["degrees"] - 35) < 1 and all(v["state"] == "free" for v in j.values()),
           f"on the board (rcb4 joint list): left_knee at 35, every joint free ({j.get('left_knee')})")
@@ -204,6 +210,11 @@ try:
     gone = time.monotonic()
     check(wait_for(lambda: any(t > gone and d.status[0].level == DiagnosticStatus.ERROR for t, d in diags), timeout=5),
           "the device gone: diagnostics ERROR")
+    # The dead device is let go, so that the kernel can give its name to the next one (a pty number,
+    # /dev/ttyUSB0 for an adapter plugged in again).
+    fds = f"/proc/{node.pid}/fd"
+    check(wait_for(lambda: not any("(deleted)" in os.readlink(os.path.join(fds, f)) for f in os.listdir(fds)),
+                   timeout=3), "the device gone: the node holds no descriptor of it")
     serve_b = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
     os.remove(link)
     os.symlink(serve_b.stdout.readline().strip(), link)
@@ -212,6 +223,20 @@ try:
     stop(node)
     serve_b.terminate()
     serve_b.wait(timeout=10)
+    # No ~device: the in-process virtual board, with a warning that it is no robot; a bad ~timeout
+    # named at start-up (exit 1).
+    states.clear()
+    rospy.delete_param("/rcb4/device")  # the runs before left theirs on the parameter server
+    node = start_node()
+    check(wait_for(lambda: len(states) > 3, timeout=15), "no ~device: joint_states")
+    stop(node)
+    out = node.stdout.read()
+    check("the in-process virtual board, a simulation, not a robot" in out,
+          f"no ~device: a warning that it is the virtual board ({out.strip()[:300]!r})")
+    node = start_node("_timeout:=abc")
+    out, _ = node.communicate(timeout=30)
+    check(node.returncode == 1 and "~timeout: 'abc' is not a number of seconds" in out,
+          f"_timeout:=abc: exit 1 naming it ({node.returncode}, {out.strip()[-120:]!r})")
 finally:
     rospy.signal_shutdown("done")
     master.terminate()

@@ -460,6 +460,13 @@ check(rc == 0 and json.loads(out)[0]["position"] in (int(first[4]), int(second[4
       f"the board shows the turned position ({out.strip()[:100]!r}, {now_at})")
 hand.send_signal(signal.SIGINT)
 check(hand.wait(timeout=10) == 0, f"serve --turn ends at SIGINT with 0 ({hand.returncode})")
+hand = subprocess.Popen([RCB4, "--json", "serve", "--pty", "--turn", "0:50"], stdout=subprocess.PIPE, text=True)
+hand.stdout.readline()
+turn = json.loads(hand.stdout.readline())
+check(turn["turned"] == 0 and turn["to"] == 8000 and turn["at"] <= time.monotonic(),
+      f"serve --turn with --json: an object per turn ({turn})")
+hand.send_signal(signal.SIGINT)
+hand.wait(timeout=10)
 expect_rc(["serve", "--pty", "--turn", "40:100"], 2, "--turn ICS")
 expect_rc(["serve", "--pty", "--turn", "0"], 2, "expected ICS:MS")
 expect_rc(["serve", "--pty", "--turn", "3:0"], 2, "--turn MS")

@@ -74,7 +74,7 @@ class Rcb4Node:
         rospy.Service("~free", Trigger, lambda r: self.trigger("free", ""))
         rospy.Service("~hold", Trigger, lambda r: self.trigger("hold", ""))
         rospy.Service("~stop_motion", Trigger, lambda r: self.trigger("stop", None))
-        rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.board.where, len(self.names),
+        rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.where, len(self.names),
                       self.rate, self.period * 1000)
 
     # --- callbacks: check, queue, never touch the line ----------------------------------------------
@@ -224,7 +224,7 @@ class Rcb4Node:
             at, targets, frames = due
             if frames > 0:
                 frames = max(1, round((at + frames * self.period - now) / self.period))
-            self.loop.write(targets, frames=min(frames, 255))
+            self.loop.write(targets, frames=frames)
         elif stream is not None:
             self.loop.write(stream, frames=max(1, round(1.0 / self.rate / self.period)))
 
