@@ -21,7 +21,7 @@ case "${1:-}" in
     cmake --build --preset dev --target rcb4_demo rcb4_cli
     ./build/dev/examples/rcb4_demo          # a virtual RCB-4 plays motion 2; the moving servos are drawn
     echo
-    echo "next: build/dev/examples/rcb4 --help   (every command works on the virtual board without a robot)"
+    echo "next: build/dev/bin/rcb4 --help   (every command works on the virtual board without a robot)"
 
     ;;
   test)

@@ -23,7 +23,7 @@ class CMakeBuild(build_ext):
         build = Path(self.build_temp).resolve() / "cmake"
         subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
                         f"-DPython_EXECUTABLE={sys.executable}", "-DRCB4_BUILD_TESTS=OFF",
-                        "-DRCB4_BUILD_EXAMPLES=OFF", "-DRCB4_BUILD_BENCHMARKS=OFF", "-DRCB4_INSTALL=OFF"],
+                        "-DRCB4_BUILD_EXAMPLES=OFF", "-DRCB4_BUILD_TOOLS=OFF", "-DRCB4_BUILD_BENCHMARKS=OFF", "-DRCB4_INSTALL=OFF"],
                        check=True)
         subprocess.run(["cmake", "--build", str(build), "--target", "pyrcb4_core", "--parallel",
                         str(os.cpu_count() or 1)], check=True)

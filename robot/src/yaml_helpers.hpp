@@ -69,7 +69,14 @@ inline YAML::Node parse_yaml(std::string_view text, const std::string& source) {
   }
 }
 
-/** The bytes of @p path; a profile_error when it cannot be read. */
+/**
+ * The largest profile, pose or motion file read (4 MiB). A motion fills at most a 2 KiB slot, so
+ * its file, comments and all, is far smaller; a bigger file is refused by its size before it is
+ * parsed (a 50 MB file once took a minute and gigabytes of memory to be refused by its content).
+ */
+inline constexpr std::uintmax_t max_file_bytes = 4u << 20;
+
+/** The bytes of @p path; a profile_error when it cannot be read or is larger than max_file_bytes. */
 inline std::string read_file(const std::filesystem::path& path) {
   // A FIFO or a device would block or never end: only regular files (or links to them) are read.
   std::error_code ec;
@@ -77,6 +84,10 @@ inline std::string read_file(const std::filesystem::path& path) {
     throw profile_error(path.string(), "is not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw profile_error(path.string(), "cannot be read (" + std::string(std::strerror(errno)) + ")");
+  if (const auto size = std::filesystem::file_size(path, ec); !ec && size > max_file_bytes)
+    throw profile_error(path.string(), "holds " + std::to_string(size) + " bytes, more than " +
+                                           std::to_string(max_file_bytes >> 20) +
+                                           " MiB: not a profile, pose or motion file (refused unread)");
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();

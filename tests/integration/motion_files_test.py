@@ -130,10 +130,16 @@ with serve("--rom", rom_file, "--period", "15") as dev:
           f"--rescale: 300 ms stays 300 ms ({rc}: {err.strip()!r})")
     check(rom(on, 0x3380 + 8 + 7, 1) == bytes([20]) and os.path.exists("six.bin"), "20 frames of 15 ms, the backup where --backup says")
 
-    # A running motion is not written over.
+    # A running motion is not written over; a slot it neither runs, calls nor returns into is
+    # (motion_safety_test.py has the rest of these rules).
     run(*on, "motion", "play", "2")
-    rc, out, err = run(*on, "motion", "push", "knee.yaml", "7")
-    check(rc == 1 and "is running" in err and rom(on, 0x3B80, 1) == b"\xff", f"push while motion 2 runs: exit 1 ({rc}: {err.strip()!r})")
+    before2 = rom(on, 0x1380, 16)
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "2")
+    check(rc == 1 and "motion 2 is running" in err and rom(on, 0x1380, 16) == before2, f"push over motion 2 while it runs: exit 1 ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "7", "--backup", "seven.bin")
+    check(rc == 0 and rom(on, 0x3B80, 1) == b"\x08", f"push into motion 7 while motion 2 runs: written ({rc}: {err.strip()!r})")
+    run(*on, "motion", "wait", "--timeout", "5")
+    run(*on, "motion", "push", "seven.bin", "7")
     run(*on, "motion", "wait", "--timeout", "5")
 
     # Erase, with a button on the slot; then the backup put back.
@@ -144,7 +150,7 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     rc, out, err = run(*on, "motion", "list")
     check(rc == 0 and "0x02B80" not in out, "motion list no longer shows 5")
     rc, out, err = run(*on, "motion", "buttons", "press", "left")
-    check(rc == 1 and "holds no motion: a press would stop the board's program" in err,
+    check(rc == 1 and "motion 5 (0x002B80) holds no motion: a play would stop the board's program there" in err,
           f"press of a button on an erased slot: refused ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "push", "five.bin", "5")
     check(rc == 0 and rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, f"the backup put back ({rc}: {out.strip()!r} {err.strip()!r})")

@@ -232,6 +232,9 @@ int main(int argc, char** argv) {
     return ctx.action();
   } catch (const cli::failure& f) {
     return fail(ctx.g, chosen(app), f);
+  } catch (const rcb4::robot::services::refused& r) {
+    return fail(ctx.g, chosen(app), cli::failure(cli::exit_of(r.kind), r.what(), r.hint,
+                                                r.backup.empty() ? cli::json() : cli::json{{"backup", r.backup}}));
   } catch (const std::system_error& e) {
     return fail(ctx.g, chosen(app), cli::explain(e.code(), e.what()));
   } catch (const boost::system::system_error& e) {

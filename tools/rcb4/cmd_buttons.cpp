@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/robot/services/motion_slots.hpp>
+
 #include <rcb4/motion/buttons.hpp>
 #include <rcb4/ops/layout.hpp>
 
@@ -224,13 +226,11 @@ void add_button_commands(CLI::App* motion, context& ctx) {
       throw usage_error(fmt::format("N: {} is outside 1..{} ({} layout)", so->n, layout.motion_count, layout.name));
     const auto n = static_cast<unsigned>(so->n);
     const auto target = rcb4::motion_address(layout, n).value();
-    const auto first = s.run(rcb4::ops::read_memory(memory::rom, target.value(), 128));
-    if (!rcb4::ops::detail::holds_frame(first))
-      throw failure(exit_board,
-                    fmt::format("motion {}'s slot (0x{:06X}) holds no motion: a button playing it would stop "
-                                "the board's program",
-                                n, target.value()),
-                    "rcb4 motion list shows the used slots");
+    {  // an empty or broken slot (as motion list marks it) would stop the board's program
+      session_link link(s, ctx.g.json);
+      rcb4::robot::services::require_playable(link, layout, n,
+                                              fmt::format("a button playing motion {}", n));
+    }
     const auto t = read_tables(s);
     auto entries = mo::assign_button(editable(t), word, target);
     if (!mo::ok(entries)) throw failure(exit_board, std::get<mo::failure>(entries).message);
@@ -277,20 +277,41 @@ void add_button_commands(CLI::App* motion, context& ctx) {
         entry = &e;
         break;
       }
-    if (!entry && std::none_of(t.ram.entries.begin(), t.ram.entries.end(), [](const auto& e) { return !e.buttons(); }))
-      throw failure(exit_board, fmt::format("no entry of the table plays anything for {}", mo::buttons_text(word)),
-                    "rcb4 motion buttons shows the table; rcb4 motion buttons set BUTTONS N adds one");
+    const bool plays = entry || std::any_of(t.ram.entries.begin(), t.ram.entries.end(),
+                                            [](const auto& e) { return !e.buttons(); });
+    if (!plays && !po->hold)
+      throw failure(exit_board,
+                    fmt::format("no entry of the table plays anything for {}: a press would only be seen by a "
+                                "motion that tests the buttons",
+                                mo::buttons_text(word)),
+                    "--hold holds them as a receiver would (for a motion's if_buttons); rcb4 motion buttons set "
+                    "BUTTONS N adds an entry");
     if (entry) {
-      const auto first = s.run(rcb4::ops::read_memory(memory::rom, entry->target.value(), 128));
-      if (!rcb4::ops::detail::holds_frame(first))
+      const std::uint32_t a = entry->target.value(), base = layout.motion_base.value();
+      const bool slot = a >= base && (a - base) % layout.slot_size == 0 && (a - base) / layout.slot_size < layout.motion_count;
+      if (slot) {  // an empty or broken slot (as motion list marks it) would stop the board's program
+        session_link link(s, ctx.g.json);
+        rcb4::robot::services::require_playable(link, layout, (a - base) / layout.slot_size + 1,
+                                                fmt::format("{} plays it", mo::buttons_text(word)));
+      } else if (!rcb4::ops::detail::holds_frame(s.run(rcb4::ops::read_memory(memory::rom, a, 128)))) {
         throw failure(exit_board,
                       fmt::format("{} plays {}, which holds no motion: a press would stop the board's program",
-                                  mo::buttons_text(word), target_text(entry->target.value(), layout, robot_of(ctx.g))),
+                                  mo::buttons_text(word), target_text(a, layout, robot_of(ctx.g))),
                       fmt::format("rcb4 motion buttons clear {}, or rcb4 motion push FILE N into that slot",
                                   mo::buttons_text(word)));
+      }
     }
     const auto bytes = rcb4::krr::encode_buttons(word);
     s.run(rcb4::ops::write_memory(memory::ram, rcb4::krr::buttons.value(), bytes));
+    if (!plays) {  // held as a receiver would hold them: only a motion's button test sees them
+      if (ctx.g.json)
+        emit(json{{"pressed", mo::buttons_text(word)}, {"motion", nullptr}, {"held", true}, {"entry", false}});
+      else
+        fmt::print("{} held (no entry of the table plays anything for them; a motion's if_buttons sees them) until "
+                   "rcb4 motion buttons release\n",
+                   mo::buttons_text(word));
+      return exit_ok;
+    }
     // The board compares the table once per output period (10-25 ms): a motion runs within a few.
     const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
     rcb4::ops::motion_state st;

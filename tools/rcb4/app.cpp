@@ -292,6 +292,31 @@ std::string_view plain_message(std::string_view what) {
   return what;
 }
 
+session_link::~session_link() = default;
+
+rcb4::reply session_link::exchange(const rcb4::command& c) {
+  rcb4::transport::error_code ec;
+  last_.emplace(s_.c().exchange(c, ec));
+  if (ec) throw rcb4::transport::system_error(ec);
+  return last_->view();
+}
+
+void session_link::failed(rcb4::errc e) {
+  rcb4::transport::error_code ec;
+  ec = e;
+  throw rcb4::transport::system_error(ec);
+}
+
+void session_link::progress(std::string_view label, std::size_t done, std::size_t total) {
+  if (!bar_ || label != label_) {
+    bar_.reset();  // the last line cleared first
+    label_ = label;
+    bar_ = std::make_unique<cli::progress>(label_, total, json_);
+  }
+  bar_->update(done);
+  if (done >= total) bar_.reset();
+}
+
 failure explain(const std::error_code& ec, std::string_view what) {
   namespace t = rcb4::transport;
   if (ec.category() == rcb4::codec_category()) {

@@ -6,6 +6,7 @@
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/motion/player.hpp>
 #include <rcb4/robot/motion_file.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 
 #include <fmt/format.h>
 
@@ -19,120 +20,21 @@ namespace {
 
 namespace mo = rcb4::motion;
 namespace ro = rcb4::robot;
+namespace sv = rcb4::robot::services;
 using rcb4::ops::memory;
-
-/** The slot of motion @p n in @p layout; a usage error outside it. */
-mo::slot slot_for(const rcb4::rom_layout& layout, long long n) {
-  const auto where = n >= 1 ? mo::slot_of(layout, static_cast<unsigned>(n)) : std::nullopt;
-  if (!where || n > layout.motion_count)
-    throw usage_error(fmt::format("N: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
-  return *where;
-}
-
-/** @p size bytes of ROM from @p at, with a progress line on a terminal. */
-std::vector<std::uint8_t> read_rom(session& s, std::uint32_t at, std::size_t size, const std::string& what,
-                                   const globals& g) {
-  rcb4::ops::read_memory op(memory::rom, at, size);
-  progress bar(what, size, g.json);
-  rcb4::transport::error_code ec;
-  std::size_t done = 0;
-  s.run_steps(op, ec, [&] { bar.update(done = std::min(size, done + rcb4::ops::max_read)); });
-  bar.finish();
-  if (ec) throw rcb4::transport::system_error(ec);
-  return op.value();
-}
-
-/** Writes @p bytes at @p at, reads them back and compares; a failure names the first differing address. */
-void write_rom_checked(session& s, std::uint32_t at, std::span<const std::uint8_t> bytes, const std::string& what,
-                       const globals& g) {
-  rcb4::ops::write_memory op(memory::rom, at, bytes);
-  progress bar(what, bytes.size(), g.json);
-  rcb4::transport::error_code ec;
-  s.run_steps(op, ec, [&] { bar.update(op.value()); });
-  bar.finish();
-  if (ec)
-    throw failure(explain(ec, "").exit,
-                  fmt::format("writing ROM 0x{:06X} failed after {} of {}: {}", at, op.value(),
-                              plural(bytes.size(), "byte"), plain_message(rcb4::transport::system_error(ec).what())),
-                  "the slot may now hold part of the new motion: the backup file puts the old one back");
-  const auto back = read_rom(s, at, bytes.size(), "reading back", g);
-  for (std::size_t i = 0; i < bytes.size(); ++i)
-    if (back[i] != bytes[i])
-      throw failure(exit_board,
-                    fmt::format("ROM 0x{:06X} reads back 0x{:02X}, 0x{:02X} was written", at + i, back[i], bytes[i]),
-                    "the board may not accept ROM writes there; the backup file puts the old motion back");
-}
-
-/** The bytes of the code the board reaches in @p l (from the slot start, in address order). */
-std::size_t code_size(const mo::listing& l) {
-  if (l.code.empty()) return 0;
-  return l.code.back().address + l.code.back().bytes.size() - l.where.address.value();
-}
 
 /** The board's output period (config bits 4-5). */
 rcb4::output_period board_period(session& s) { return s.run(rcb4::ops::read_config{}).period; }
 
-/** Saves @p bytes (a slot's old contents) to @p path, or to motion-N-DATE.bin when it is empty. */
-std::string backup(const std::vector<std::uint8_t>& bytes, std::string path, unsigned n) {
-  if (path.empty()) {
-    path = fmt::format("motion-{}-{}.bin", n, file_stamp());
-    for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", n, file_stamp(), k);
-  }
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  out.flush();
-  if (!out)
-    throw failure(
-        exit_usage,
-        fmt::format("cannot write the backup {}: {} (nothing was written to the board)", path, std::strerror(errno)),
-        "--backup FILE names another place");
-  return path;
-}
-
-/** Refuses to write while the ROM program runs a motion (the board would fetch the bytes being replaced). */
-void require_idle(session& s, const rcb4::rom_layout& layout, unsigned n) {
-  // A motion slot's code running (servos still moving after a host move set the update flags too: that is no program).
-  const auto st = s.run(rcb4::ops::read_motion_state(layout));
-  if (st.running && st.motion)
-    throw failure(exit_board,
-                  fmt::format("motion {} is running: the board would run the bytes being written", *st.motion),
-                  "rcb4 motion wait, or rcb4 motion stop, then write");
-  // Stopped part way in this slot: motion resume would continue in the middle of the new bytes.
-  if (st.suspended && st.motion && *st.motion == n)
-    throw failure(exit_board,
-                  fmt::format("motion {} is stopped part way (program counter 0x{:06X}): motion resume would continue "
-                              "in the middle of the bytes being written",
-                              n, st.program_counter),
-                  "rcb4 motion play N (any motion) starts the program afresh; then write");
+/** A backup sink for the services: --backup FILE, or motion-N-DATE.bin here; a failure to save is a usage error. */
+sv::backup_sink backup_to(const std::string& path) {
+  return [path](unsigned n, std::span<const std::uint8_t> old) { return sv::save_backup_file(n, old, path); };
 }
 
 /** Warns when a remote button plays motion @p n (erased or changed, a press plays what is there now). */
 void warn_buttons(session& s, const mo::slot& where, unsigned n, std::string_view what, const globals& g) {
   const auto b = entries_playing(s, where.address.value());
   if (!b.empty() && !g.json) fmt::print(stderr, "note: {} plays motion {}: {}\n", fmt::join(b, ", "), n, what);
-}
-
-/**
- * Refuses a program that calls an empty slot: the board's program would stop there (program-error).
- * @p where_ is each step's "FILE:LINE", @p done what did not happen ("written", "sent").
- */
-void check_callees(session& s, const mo::program& p, const mo::slot& where, const rcb4::rom_layout& layout,
-                   const std::vector<std::string>& where_, std::string_view done) {
-  for (std::size_t i = 0; i < p.steps.size(); ++i)
-    if (const auto* c = std::get_if<mo::call_motion>(&p.steps[i]); c && c->address != where.address) {
-      const auto first = s.run(rcb4::ops::read_memory(memory::rom, c->address.value(), 128));
-      if (rcb4::ops::detail::holds_frame(first)) continue;
-      const std::uint32_t a = c->address.value(), base = layout.motion_base.value();
-      const bool slot = a >= base && (a - base) % layout.slot_size == 0;
-      throw failure(exit_board,
-                    fmt::format("step {}{} calls {}, which holds no motion: the board's program would stop there "
-                                "(nothing was {})",
-                                i + 1, i < where_.size() ? fmt::format(" ({})", where_[i]) : std::string(),
-                                slot ? fmt::format("motion {} (0x{:06X})", (a - base) / layout.slot_size + 1, a)
-                                     : fmt::format("0x{:06X}", a),
-                                done),
-                    "push that motion first; rcb4 motion list shows the used slots");
-    }
 }
 
 /** The --layout value that names @p layout, for hints a user can paste. */
@@ -151,50 +53,33 @@ struct pull_options {
 
 int pull(session& s, const pull_options& o, const globals& g) {
   const auto& layout = layout_for(s, o.m);
-  const auto where = slot_for(layout, o.n);
+  sv::slot_for(layout, o.n);  // a number outside the layout before anything else
   const auto n = static_cast<unsigned>(o.n);
   if (std::filesystem::exists(o.file) && !o.force)
     throw usage_error(fmt::format("FILE: {} exists (--force replaces it)", o.file));
-  const auto bytes = read_rom(s, where.address.value(), where.size, fmt::format("reading motion {}", n), g);
-  if (bytes.empty() || bytes[0] == 0xFF)
-    throw failure(exit_board, fmt::format("motion {} (0x{:06X}) is empty: erased ROM", n, where.address.value()),
-                  "rcb4 motion list shows the used slots");
-  const auto l = mo::disassemble(bytes, where);
-  if (!l.problems.empty())
-    throw failure(exit_board, fmt::format("motion {}: {}", n, l.problems.front()),
-                  fmt::format("rcb4 motion show {} lists the code the board reaches", n));
-  const auto p = mo::lift(l);
-  if (!mo::ok(p))
-    throw failure(exit_board,
-                  fmt::format("motion {} is code a motion file cannot say: {}", n, std::get<mo::failure>(p).message),
-                  fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n,
-                              where.address.value(), code_size(l)));
-  const auto period = board_period(s);
-  const auto& robot = robot_of(g);
-  auto d = ro::from_program(std::get<mo::program>(p), robot, layout, period);
-  d.name = std::string(robot.motion(n));
-  // Checked as push will check it: a pose beyond a limit pulls, but does not push back as it is.
-  const auto again = ro::to_program(d, robot, layout, period);
+  session_link link(s, g.json);
+  const auto r = sv::pull_motion(link, robot_of(g), layout, n);
   std::string comment = fmt::format(
       "motion {} of the board (0x{:06X}, {} layout), pulled by rcb4 on {}\n"
       "rcb4 motion push {} {} writes it back",
-      n, where.address.value(), layout.name, file_stamp(), o.file, n);
+      n, r.address, layout.name, file_stamp(), o.file, n);
   try {
-    ro::save_motion(o.file, d, comment);
+    ro::save_motion(o.file, r.document, comment);
   } catch (const ro::profile_error& e) {
     throw usage_error(e.what());
   }
-  std::size_t poses = 0;
-  long long ms = 0;
-  for (const auto& st : d.steps)
-    if (const auto* mp = std::get_if<ro::motion_pose>(&st)) ++poses, ms += mp->time.count();
-  const std::string beyond = ro::ok(again) ? std::string() : std::get<ro::problem>(again).message;
+  const auto& d = r.document;
+  const auto& where = mo::slot_of(layout, n).value();
+  const auto poses = r.poses;
+  const auto ms = r.pose_ms;
+  const auto period = r.period;
+  const auto& beyond = r.beyond;
   if (g.json) {
     emit(json{{"pulled", n},
               {"file", o.file},
               {"layout", layout.name},
               {"address", where.address.value()},
-              {"bytes", code_size(l)},
+              {"bytes", r.bytes},
               {"steps", d.steps.size()},
               {"poses", poses},
               {"pose_ms", ms},
@@ -202,7 +87,7 @@ int pull(session& s, const pull_options& o, const globals& g) {
               {"problem", beyond.empty() ? json(nullptr) : json(beyond)}});
   } else {
     fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({:.2f} s of moves at {} ms frames) -> {}\n", n,
-               where.address.value(), layout.name, code_size(l), d.steps.size(), plural(poses, "pose"),
+               where.address.value(), layout.name, r.bytes, d.steps.size(), plural(poses, "pose"),
                static_cast<double>(ms) / 1000, rcb4::milliseconds(period), o.file);
     if (!beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", beyond);
   }
@@ -216,130 +101,102 @@ struct push_options {
   bool rescale = false, dry_run = false;
 };
 
-/** The bytes FILE stands for at @p where: a motion file assembled, or a .bin backup as it is. */
-std::vector<std::uint8_t> bytes_of(session& s, const push_options& o, const rcb4::rom_layout& layout,
-                                   const mo::slot& where, std::vector<std::string>& notes, std::string& summary,
-                                   const globals& g) {
+/** What FILE stands for: a motion file's document, or a .bin backup's bytes. */
+sv::push_source source_of(const push_options& o, const globals& g) {
+  sv::push_source src;
+  src.name = o.file;
+  src.rescale = o.rescale;
   if (std::filesystem::path(o.file).extension() == ".bin") {
     std::ifstream in(o.file, std::ios::binary);
     if (!in) throw usage_error(fmt::format("FILE: {} cannot be read ({})", o.file, std::strerror(errno)));
-    std::vector<std::uint8_t> b{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-    if (b.empty() || b.size() > where.size)
-      throw usage_error(
-          fmt::format("FILE: {} holds {}; a slot takes 1..{}", o.file, plural(b.size(), "byte"), where.size));
-    // Only what the board reaches: an erased tail stays unwritten.
-    const auto l = mo::disassemble(b, where);
-    if (b[0] != 0xFF && !l.problems.empty())
-      throw usage_error(fmt::format("FILE: {} is not motion code for 0x{:06X}: {}", o.file, where.address.value(),
-                                    l.problems.front()));
-    summary = b[0] == 0xFF ? "an empty slot" : fmt::format("{} reachable frames", l.code.size());
-    return b;
+    // A slot holds at most a few KiB: read one byte more than the largest, never a whole big file.
+    src.bin.resize(8193);
+    in.read(reinterpret_cast<char*>(src.bin.data()), static_cast<std::streamsize>(src.bin.size()));
+    src.bin.resize(static_cast<std::size_t>(in.gcount()));
+    return src;
   }
-  ro::motion_document d;
   try {
-    d = ro::load_motion(o.file, robot_of(g));
+    src.document = ro::load_motion(o.file, robot_of(g));
   } catch (const ro::profile_error& e) {
     throw usage_error(e.what());
   }
-  const auto c = ro::to_program(d, robot_of(g), layout, board_period(s), o.rescale);
-  if (!ro::ok(c))
-    throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<ro::problem>(c).message));
-  const auto& cm = std::get<ro::compiled_motion>(c);
-  check_callees(s, cm.program, where, layout, d.where, "written");
-  notes = cm.notes;
-  const auto b = mo::assemble(cm.program, where);
-  if (!mo::ok(b))
-    throw usage_error(fmt::format("{}: {} (nothing was written)", o.file, std::get<mo::failure>(b).message));
-  std::size_t poses = 0;
-  unsigned frames = 0;
-  for (const auto& st : cm.program.steps)
-    if (const auto* p = std::get_if<mo::pose>(&st)) ++poses, frames += p->time.value();
-  summary = fmt::format("{} steps, {} ({:.2f} s of moves)", cm.program.steps.size(), plural(poses, "pose"),
-                        frames * rcb4::milliseconds(cm.period) / 1000.0);
-  return std::get<std::vector<std::uint8_t>>(b);
+  return src;
 }
 
 int push(session& s, const push_options& o, const globals& g) {
   const auto& layout = layout_for(s, o.m);
-  const auto where = slot_for(layout, o.n);
+  sv::slot_for(layout, o.n);  // a number outside the layout before anything else
   const auto n = static_cast<unsigned>(o.n);
-  std::vector<std::string> notes;
-  std::string summary;
-  const auto bytes = bytes_of(s, o, layout, where, notes, summary, g);
+  const auto src = source_of(o, g);
+  session_link link(s, g.json);
+  const auto r = sv::push_motion(link, robot_of(g), layout, n, src, backup_to(o.backup), o.dry_run);
   if (!g.json)
-    for (const auto& note : notes) fmt::print(stderr, "note: {}\n", note);
-  if (o.dry_run) {
+    for (const auto& note : r.notes) fmt::print(stderr, "note: {}\n", note);
+  if (r.dry_run) {
     if (g.json)
       emit(json{{"dry_run", true},
                 {"motion", n},
-                {"address", where.address.value()},
-                {"bytes", bytes.size()},
-                {"hex", fmt::format("{}", rcb4::hex_view{bytes})},
-                {"notes", notes}});
+                {"address", r.address},
+                {"bytes", r.bytes.size()},
+                {"hex", fmt::format("{}", rcb4::hex_view{r.bytes})},
+                {"notes", r.notes}});
     else
-      fmt::print("would write {} to motion {} (0x{:06X}, {} layout): {}\n{}\n", plural(bytes.size(), "byte"), n,
-                 where.address.value(), layout.name, summary, rcb4::hex_view{bytes});
+      fmt::print("would write {} to motion {} (0x{:06X}, {} layout): {}\n{}\n", plural(r.bytes.size(), "byte"), n,
+                 r.address, layout.name, r.summary, rcb4::hex_view{r.bytes});
     return exit_ok;
   }
-  require_idle(s, layout, n);
-  const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
-  if (std::equal(bytes.begin(), bytes.end(), old.begin())) {
+  if (r.unchanged) {
     if (g.json)
-      emit(json{{"pushed", n}, {"address", where.address.value()}, {"bytes", bytes.size()}, {"unchanged", true}});
+      emit(json{{"pushed", n}, {"address", r.address}, {"bytes", r.bytes.size()}, {"unchanged", true}});
     else
-      fmt::print("motion {} (0x{:06X}) already holds these {}: nothing written\n", n, where.address.value(),
-                 plural(bytes.size(), "byte"));
+      fmt::print("motion {} (0x{:06X}) already holds these {}: nothing written\n", n, r.address,
+                 plural(r.bytes.size(), "byte"));
     return exit_ok;
   }
-  const auto saved = backup(old, o.backup, n);
-  write_rom_checked(s, where.address.value(), bytes, fmt::format("writing motion {}", n), g);
-  warn_buttons(s, where, n, "a press plays the new one", g);
+  warn_buttons(s, mo::slot_of(layout, n).value(), n, "a press plays the new one", g);
   if (g.json) {
     emit(json{{"pushed", n},
-              {"address", where.address.value()},
+              {"address", r.address},
               {"layout", layout.name},
-              {"bytes", bytes.size()},
+              {"bytes", r.bytes.size()},
               {"unchanged", false},
-              {"backup", saved},
-              {"notes", notes}});
+              {"backup", r.backup},
+              {"notes", r.notes}});
   } else {
     fmt::print("wrote {} to motion {} (0x{:06X}..0x{:06X}, {} layout) and read them back: {}\n",
-               plural(bytes.size(), "byte"), n, where.address.value(), where.address.value() + bytes.size() - 1,
-               layout.name, summary);
-    fmt::print("the slot's old bytes are in {} (rcb4 motion push {} {} puts them back)\n", saved, saved, n);
+               plural(r.bytes.size(), "byte"), n, r.address, r.address + r.bytes.size() - 1, layout.name, r.summary);
+    fmt::print("the slot's old bytes are in {} (rcb4 motion push {} {} puts them back)\n", r.backup, r.backup, n);
   }
   return exit_ok;
 }
 
 int erase(session& s, const push_options& o, const globals& g) {
   const auto& layout = layout_for(s, o.m);
-  const auto where = slot_for(layout, o.n);
+  sv::slot_for(layout, o.n);  // a number outside the layout before anything else
   const auto n = static_cast<unsigned>(o.n);
-  require_idle(s, layout, n);
-  const auto old = read_rom(s, where.address.value(), where.size, fmt::format("backing up motion {}", n), g);
-  if (std::all_of(old.begin(), old.end(), [](std::uint8_t b) { return b == 0xFF; })) {
+  session_link link(s, g.json);
+  const auto r = sv::erase_motion(link, layout, n, backup_to(o.backup));
+  if (r.unchanged) {
     if (g.json)
-      emit(json{{"erased", n}, {"address", where.address.value()}, {"unchanged", true}});
+      emit(json{{"erased", n}, {"address", r.address}, {"unchanged", true}});
     else
-      fmt::print("motion {} (0x{:06X}) is already empty: nothing written\n", n, where.address.value());
+      fmt::print("motion {} (0x{:06X}) is already empty: nothing written\n", n, r.address);
     return exit_ok;
   }
-  const auto saved = backup(old, o.backup, n);
-  const std::vector<std::uint8_t> erased(where.size, 0xFF);
-  write_rom_checked(s, where.address.value(), erased, fmt::format("erasing motion {}", n), g);
-  warn_buttons(s, where, n, "a press now stops the board's program (rcb4 motion buttons clear)", g);
+  warn_buttons(s, mo::slot_of(layout, n).value(), n, "a press now stops the board's program (rcb4 motion buttons clear)",
+               g);
   // Motion 1 is where the layout is told from: without it, --layout must say it.
   const std::string again = n == 1 && o.m.layout == "auto" ? fmt::format(" --layout {}", layout_flag(layout)) : "";
   if (!again.empty() && !g.json)
     fmt::print(stderr, "note: motion 1 told the board's layout ({}); from now on give it: --layout {}\n", layout.name,
                layout_flag(layout));
   if (g.json)
-    emit(json{{"erased", n}, {"address", where.address.value()}, {"unchanged", false}, {"backup", saved}});
+    emit(json{{"erased", n}, {"address", r.address}, {"unchanged", false}, {"backup", r.backup}});
   else
     fmt::print(
         "erased motion {} (0x{:06X}, {} bytes of 0xFF, read back); the old bytes are in {} "
         "(rcb4 motion push {} {}{} puts them back)\n",
-        n, where.address.value(), where.size, saved, saved, n, again);
+        n, r.address, r.size, r.backup, r.backup, n, again);
   return exit_ok;
 }
 
@@ -393,7 +250,16 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
                                     j ? j->name : "a servo", e.ics.value()),
                         "rcb4 scan shows the board's slots");
         }
-  check_callees(s, cm.program, mo::slot{rcb4::rom_address{}, 0}, layout, d.where, "sent");
+  {
+    // Its calls checked as a push checks them (the host plays the poses; the board runs each call).
+    const auto code = mo::assemble(cm.program, mo::slot{rcb4::rom_address{}, 0x40000});
+    if (mo::ok(code)) {
+      const auto& bytes = std::get<std::vector<std::uint8_t>>(code);
+      session_link link(s, g.json);
+      sv::check_calls(link, layout, mo::disassemble(bytes, mo::slot{rcb4::rom_address{}, 0x40000}), &cm.program,
+                      d.where, "sent");
+    }
+  }
   mo::player pl(cm.program);
   if (!pl.error().empty()) throw usage_error(fmt::format("{}: {}", file, pl.error()));
   const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period));

@@ -1,5 +1,5 @@
 // rcb4 ui: the page. One WebSocket to the server that owns the board; no library, no network
-// beyond this server. Messages: examples/rcb4/ui/messages.hpp (to the server), board_loop.cpp
+// beyond this server. Messages: tools/rcb4/ui/messages.hpp (to the server), board_loop.cpp
 // and controller.cpp (from it).
 'use strict';
 

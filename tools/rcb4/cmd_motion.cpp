@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/robot/services/motion_slots.hpp>
+
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/ops/layout.hpp>
 
@@ -124,6 +126,11 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
   if (n > layout.motion_count)
     throw usage_error(
         fmt::format("motion number: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
+  {
+    // An empty or broken slot (as motion list marks it) would stop the board's program: refused first.
+    session_link link(s, g.json);
+    rcb4::robot::services::require_playable(link, layout, n, fmt::format("motion play {}", n));
+  }
   s.run(rcb4::ops::play_motion(n, layout, release ? rcb4::ops::servo_power::release : rcb4::ops::servo_power::keep));
   if (!and_wait) {
     if (g.json) {

@@ -8,6 +8,7 @@
 #include <rcb4/ops.hpp>
 #include <rcb4/robot/ops.hpp>
 #include <rcb4/robot/profile.hpp>
+#include <rcb4/robot/services/link.hpp>
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/operations.hpp>
@@ -46,6 +47,11 @@ struct failure : std::runtime_error {
   std::string hint;              ///< the fix, or empty
   nlohmann::ordered_json extra;  ///< facts for --json (e.g. how far a transfer got), or null
 };
+
+/** The exit code of a robot service's refusal: board 1, usage and limit 2. */
+constexpr int exit_of(rcb4::robot::services::refusal_kind k) noexcept {
+  return k == rcb4::robot::services::refusal_kind::board ? exit_board : exit_usage;
+}
 
 /** A command-line mistake found after parsing (a value out of range, a servo given twice): exit 2. */
 struct usage_error : failure {
@@ -160,6 +166,32 @@ class session {
   std::unique_ptr<client> client_;
   std::string where_;
   bool rate_known_ = true;
+};
+
+/** A progress line on stderr for long work: only on a terminal, never under --json. */
+class progress;
+
+/** The session as the robot services see it: exchanges, failures as the tool reports them, progress lines. */
+class session_link final : public rcb4::robot::services::link {
+ public:
+  /** Over @p s; progress lines unless @p json. */
+  session_link(session& s, bool json) : s_(s), json_(json) {}
+  ~session_link() override;
+  session_link(const session_link&) = delete;
+  session_link& operator=(const session_link&) = delete;
+  /** One exchange through the session's client; a failed line throws rcb4::transport::system_error. */
+  rcb4::reply exchange(const rcb4::command& c) override;
+  /** Throws rcb4::transport::system_error(@p e). */
+  [[noreturn]] void failed(rcb4::errc e) override;
+  /** A progress line per label, cleared when the label changes. */
+  void progress(std::string_view label, std::size_t done, std::size_t total) override;
+
+ private:
+  session& s_;
+  bool json_;
+  std::optional<rcb4::transport::response> last_;
+  std::unique_ptr<cli::progress> bar_;
+  std::string label_;
 };
 
 /** A progress line on stderr for long work: only on a terminal, never under --json. */

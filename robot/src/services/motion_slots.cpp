@@ -1,0 +1,443 @@
+// rcb4 — robot services: the ROM's motion slots (see rcb4/robot/services/motion_slots.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/ops/memory.hpp>
+#include <rcb4/ops/motion.hpp>
+#include <rcb4/ops/system.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace rcb4::robot::services {
+namespace {
+
+namespace mo = rcb4::motion;
+
+/** A listing's first problem, without the disassembler's ": the board stops here" (the caller says what follows). */
+std::string first_problem(const mo::listing& code) {
+  std::string p = code.problems.front();
+  constexpr std::string_view tail = ": the board stops here";
+  if (p.size() > tail.size() && p.compare(p.size() - tail.size(), tail.size(), tail) == 0) p.resize(p.size() - tail.size());
+  return p;
+}
+using rcb4::ops::memory;
+
+/** The board's call stack (protocol.md §4: 16 deep); a motion played takes one level itself (§8.1). */
+constexpr unsigned stack_depth = 16;
+
+/** The motion slot that holds ROM address @p a, if any. */
+std::optional<unsigned> slot_number(const rom_layout& layout, std::uint32_t a) {
+  const std::uint32_t base = layout.motion_base.value();
+  if (a < base || (a - base) / layout.slot_size >= layout.motion_count) return std::nullopt;
+  return (a - base) / layout.slot_size + 1;
+}
+
+/** "motion 5 (0x002B80)", or the address alone outside the slots. */
+std::string name_of(const rom_layout& layout, std::uint32_t a) {
+  const auto n = slot_number(layout, a);
+  if (!n) return mo::hex_address(a);
+  const std::uint32_t start = layout.motion_base.value() + (*n - 1) * layout.slot_size;
+  return a == start ? fmt::format("motion {} ({})", *n, mo::hex_address(a))
+                    : fmt::format("motion {} at {}", *n, mo::hex_address(a));
+}
+
+/** The code from @p at to the end of its slot (or 2 KiB outside the slots) as the board runs it. */
+struct code_at {
+  std::vector<std::uint8_t> bytes;  // the listing's commands point into these
+  mo::listing code;
+};
+
+/**
+ * The reachable code of the ROM from @p at, read once per address: the call graph of the slots
+ * is walked through it. @p own is the code a push is about to write (its slot read from there).
+ */
+class rom_code {
+ public:
+  rom_code(link& l, const rom_layout& layout, const mo::listing* own) : l_(l), layout_(layout), own_(own) {}
+
+  /** The code at @p at. */
+  const mo::listing& at(std::uint32_t a) {
+    if (own_ && a == own_->where.address.value()) return *own_;
+    auto it = read_.find(a);
+    if (it != read_.end()) return it->second->code;
+    auto c = std::make_unique<code_at>();
+    const auto n = slot_number(layout_, a);
+    const std::uint32_t end = n ? layout_.motion_base.value() + *n * layout_.slot_size : a + 2048;
+    const auto where = mo::slot{rom_address::make(a).value(), end - a};
+    c->bytes = read_rom(l_, a, where.size, fmt::format("reading {}", name_of(layout_, a)));
+    c->code = c->bytes.empty() || c->bytes[0] == 0xFF ? mo::listing{where, {}, {}, {"it is empty (erased ROM)"}, {}}
+                                                      : mo::disassemble(c->bytes, where);
+    return read_.emplace(a, std::move(c)).first->second->code;
+  }
+
+  /**
+   * The levels of the stack the code at @p a takes when CALLed (its own and its callees'), or
+   * nothing when its calls come back to a caller still on the stack (recursion); the chain of
+   * the deepest path goes to @p chain. A callee that is empty or broken is refused by the caller.
+   */
+  std::optional<unsigned> depth(std::uint32_t a, std::vector<std::uint32_t>& chain) {
+    if (auto it = depth_.find(a); it != depth_.end()) {
+      chain = it->second.second;
+      return it->second.first;
+    }
+    if (std::find(path_.begin(), path_.end(), a) != path_.end()) {
+      chain.assign(std::find(path_.begin(), path_.end(), a), path_.end());
+      chain.push_back(a);
+      return std::nullopt;
+    }
+    path_.push_back(a);
+    unsigned best = 0;
+    std::vector<std::uint32_t> best_chain;
+    for (const auto callee : at(a).calls) {
+      std::vector<std::uint32_t> sub;
+      const auto d = depth(callee, sub);
+      if (!d) {
+        path_.pop_back();
+        chain = std::move(sub);
+        return std::nullopt;
+      }
+      if (*d > best) best = *d, best_chain = std::move(sub);
+    }
+    path_.pop_back();
+    best_chain.insert(best_chain.begin(), a);
+    depth_[a] = {best + 1, best_chain};
+    chain = std::move(best_chain);
+    return best + 1;
+  }
+
+  /** True when the code at @p from CALLs (through any number of slots) into the slot of @p target. */
+  bool reaches(std::uint32_t from, std::uint32_t target) {
+    std::set<std::uint32_t> seen;
+    std::vector<std::uint32_t> todo{from};
+    const auto goal = slot_number(layout_, target);
+    while (!todo.empty()) {
+      const auto a = todo.back();
+      todo.pop_back();
+      if (!seen.insert(a).second) continue;
+      for (const auto callee : at(a).calls) {
+        if (callee == target || (goal && slot_number(layout_, callee) == goal)) return true;
+        todo.push_back(callee);
+      }
+    }
+    return false;
+  }
+
+ private:
+  link& l_;
+  const rom_layout& layout_;
+  const mo::listing* own_;
+  std::map<std::uint32_t, std::unique_ptr<code_at>> read_;
+  std::map<std::uint32_t, std::pair<unsigned, std::vector<std::uint32_t>>> depth_;
+  std::vector<std::uint32_t> path_;
+};
+
+/** "motion 3 (0x001B80) -> motion 4 (0x002380)" */
+std::string chain_text(const rom_layout& layout, const std::vector<std::uint32_t>& chain) {
+  std::string out;
+  for (const auto a : chain) out += (out.empty() ? "" : " -> ") + name_of(layout, a);
+  return out;
+}
+
+/** Writes @p bytes at @p at and reads them back; a failure is refused naming @p saved and how to put it back. */
+void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> bytes, std::string_view label,
+                       unsigned n, const std::string& saved) {
+  const std::string undo =
+      saved.empty() ? std::string()
+                    : fmt::format("the slot's old bytes are in {}: rcb4 motion push {} {} puts them back", saved,
+                                  saved, n);
+  rcb4::ops::write_memory op(memory::rom, at, bytes);
+  try {
+    while (auto c = op.next()) {
+      op.on_reply(l.exchange(*c));
+      l.progress(label, op.value(), bytes.size());
+    }
+    if (op.error() != errc{}) l.failed(op.error());
+  } catch (const refused&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw refused(refusal_kind::board,
+                  fmt::format("writing ROM 0x{:06X} failed after {} of {} bytes: {}", at, op.value(), bytes.size(),
+                              e.what()),
+                  "the slot may now hold part of the new motion; " + undo, saved);
+  }
+  std::vector<std::uint8_t> back;
+  try {
+    back = read_rom(l, at, bytes.size(), "reading back");
+  } catch (const std::exception& e) {
+    throw refused(refusal_kind::board,
+                  fmt::format("reading back ROM 0x{:06X} after the write failed: {}", at, e.what()),
+                  "the slot holds what was written, unchecked; " + undo, saved);
+  }
+  for (std::size_t i = 0; i < bytes.size(); ++i)
+    if (back[i] != bytes[i])
+      throw refused(refusal_kind::board,
+                    fmt::format("ROM 0x{:06X} reads back 0x{:02X}, 0x{:02X} was written", at + i, back[i], bytes[i]),
+                    "the board may not accept ROM writes there; " + undo, saved);
+}
+
+}  // namespace
+
+std::string save_backup_file(unsigned motion, std::span<const std::uint8_t> old, const std::string& path_) {
+  std::string path = path_;
+  if (path.empty()) {
+    char stamp[32];
+    const std::time_t t = std::time(nullptr);
+    std::tm tm{};
+    ::localtime_r(&t, &tm);
+    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+    path = fmt::format("motion-{}-{}.bin", motion, stamp);
+    for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", motion, stamp, k);
+  } else if (std::filesystem::exists(path)) {
+    throw refused(refusal_kind::usage, fmt::format("the backup {} exists: a backup never replaces a file", path));
+  }
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(old.data()), static_cast<std::streamsize>(old.size()));
+  out.flush();
+  if (!out)
+    throw refused(refusal_kind::usage,
+                  fmt::format("cannot write the backup {}: {} (nothing was written to the board)", path,
+                              std::strerror(errno)),
+                  "name another place for the backup");
+  return path;
+}
+
+mo::slot slot_for(const rom_layout& layout, long long n) {
+  const auto where = n >= 1 ? mo::slot_of(layout, static_cast<unsigned>(n)) : std::nullopt;
+  if (!where || n > layout.motion_count)
+    throw refused(refusal_kind::usage,
+                  fmt::format("N: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
+  return *where;
+}
+
+std::vector<std::uint8_t> read_rom(link& l, std::uint32_t at, std::size_t size, std::string_view label) {
+  rcb4::ops::read_memory op(memory::rom, at, size);
+  std::size_t done = 0;
+  while (auto c = op.next()) {
+    op.on_reply(l.exchange(*c));
+    l.progress(label, done = std::min(size, done + rcb4::ops::max_read), size);
+  }
+  if (op.error() != errc{}) l.failed(op.error());
+  return op.value();
+}
+
+std::size_t code_size(const mo::listing& code) {
+  if (code.code.empty()) return 0;
+  return code.code.back().address + code.code.back().bytes.size() - code.where.address.value();
+}
+
+void check_calls(link& l, const rom_layout& layout, const mo::listing& code, const mo::program* steps,
+                 const std::vector<std::string>& where_, std::string_view done) {
+  rom_code rom(l, layout, &code);
+  const std::uint32_t self = code.where.address.value();
+  // Each call, in the order the steps make them, so the message names the step.
+  std::vector<std::uint32_t> order;
+  for (const auto& in : code.code)
+    if (in.cmd)
+      if (const auto* c = std::get_if<rcb4::call>(&*in.cmd); c && c->target().value() != self)
+        if (std::find(order.begin(), order.end(), c->target().value()) == order.end())
+          order.push_back(c->target().value());
+  const auto step_of = [&](std::uint32_t callee) {
+    if (steps)
+      for (std::size_t i = 0; i < steps->steps.size(); ++i)
+        if (const auto* c = std::get_if<mo::call_motion>(&steps->steps[i]); c && c->address.value() == callee)
+          return fmt::format("step {}{} calls", i + 1, i < where_.size() ? fmt::format(" ({})", where_[i]) : "");
+    return std::string("it calls");
+  };
+  for (const auto callee : order) {
+    const auto& c = rom.at(callee);
+    if (!c.problems.empty())
+      throw refused(refusal_kind::board,
+                    fmt::format("{} {}, which {}: the board's program would stop there (nothing was {})",
+                                step_of(callee), name_of(layout, callee),
+                                c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")", done),
+                    c.code.empty() ? "push that motion first; rcb4 motion list shows the used slots"
+                                   : "rcb4 motion show N lists its code; push it again");
+  }
+  std::vector<std::uint32_t> chain;
+  const auto d = rom.depth(self, chain);
+  if (!d) {
+    chain.erase(chain.begin(), std::find(chain.begin(), chain.end(), chain.back()));
+    throw refused(refusal_kind::board,
+                  fmt::format("its calls come back round ({}): every pass takes another level of the board's "
+                              "{}-deep call stack until the board stops (nothing was {})",
+                              chain_text(layout, chain), stack_depth, done),
+                  "a motion that repeats itself loops with goto, not call");
+  }
+  // The play's own CALL (or the caller's) takes a level before the motion's first byte.
+  if (*d > stack_depth)
+    throw refused(refusal_kind::board,
+                  fmt::format("its calls nest {} deep ({}): played, it needs {} levels of the board's {}-deep call "
+                              "stack, so the board would stop (nothing was {})",
+                              *d - 1, chain_text(layout, chain), *d, stack_depth, done),
+                  "call fewer motions within each other");
+}
+
+void require_writable(link& l, const rom_layout& layout, unsigned n, std::span<const std::uint8_t> old,
+                      std::string_view doing) {
+  const auto st = run(l, rcb4::ops::read_motion_state(layout));
+  if (!st.running && !st.suspended) return;
+  const auto where = slot_for(layout, n);
+  const std::uint32_t base = where.address.value();
+  const std::string state = st.running ? "is running" : "is stopped part way";
+  const std::string pc_name = name_of(layout, st.program_counter);
+  const std::string hint = st.running ? "rcb4 motion wait, or rcb4 motion stop and then rcb4 motion play N (any "
+                                        "motion), which starts the program afresh; then write"
+                                      : "rcb4 motion play N (any motion) starts the program afresh; then write";
+  if (st.motion && *st.motion == n)
+    throw refused(refusal_kind::board,
+                  fmt::format("motion {} {} (program counter 0x{:06X}): {} in the middle of the bytes being {}", n,
+                              state, st.program_counter,
+                              st.running ? "the board would run on" : "motion resume would continue", doing),
+                  hint);
+  mo::listing own{where, {}, {}, {}, {}};
+  if (!old.empty() && old[0] != 0xFF) own = mo::disassemble(old, where);
+  rom_code rom(l, layout, &own);
+  // A CALL of this slot's on the stack: the callee's RETURN would land in the new bytes.
+  if (st.depth >= 2 && rom.reaches(base, st.program_counter))
+    throw refused(refusal_kind::board,
+                  fmt::format("the board's program {} in {}, which motion {} called: a return into motion {} is on "
+                              "the board's call stack ({} levels), so {} would return into the bytes being {}",
+                              state, pc_name, n, n, st.depth,
+                              st.running ? "the program" : "motion resume", doing),
+                  hint);
+  // A running motion that calls this slot would run it while it is written.
+  const auto pc_slot = slot_number(layout, st.program_counter);
+  if (st.running && pc_slot) {
+    const std::uint32_t pc_base = layout.motion_base.value() + (*pc_slot - 1) * layout.slot_size;
+    if (rom.reaches(pc_base, base))
+      throw refused(refusal_kind::board,
+                    fmt::format("motion {} is running and calls motion {}: the board could run the bytes being {}",
+                                *pc_slot, n, doing),
+                    hint);
+  }
+}
+
+void require_playable(link& l, const rom_layout& layout, unsigned n, std::string_view what) {
+  const auto where = slot_for(layout, n);
+  rom_code rom(l, layout, nullptr);
+  const auto& c = rom.at(where.address.value());
+  if (c.problems.empty()) return;
+  throw refused(refusal_kind::board,
+                fmt::format("{}: motion {} (0x{:06X}) {}: a play would stop the board's program there", what, n,
+                            where.address.value(),
+                            c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")"),
+                c.code.empty() ? "rcb4 motion list shows the used slots"
+                               : fmt::format("rcb4 motion show {} lists its code; push it again", n));
+}
+
+namespace {
+/** The board's output period (config bits 4-5). */
+output_period board_period(link& l) { return run(l, rcb4::ops::read_config{}).period; }
+}  // namespace
+
+push_report push_motion(link& l, const model& robot, const rom_layout& layout, unsigned n, const push_source& src,
+                        const backup_sink& backup, bool dry_run) {
+  const auto where = slot_for(layout, n);
+  push_report r;
+  r.motion = n;
+  r.address = where.address.value();
+  r.layout = layout.name;
+  r.dry_run = dry_run;
+  mo::listing code;
+  if (!src.document) {  // a backup's bytes, as they are
+    const auto& b = src.bin;
+    if (b.empty() || b.size() > where.size)
+      throw refused(refusal_kind::usage,
+                    fmt::format("FILE: {} holds {} bytes; a slot takes 1..{}", src.name, b.size(), where.size));
+    code = mo::disassemble(b, where);
+    if (b[0] != 0xFF && !code.problems.empty())
+      throw refused(refusal_kind::usage, fmt::format("FILE: {} is not motion code for 0x{:06X}: {}", src.name,
+                                                     where.address.value(), code.problems.front()));
+    r.summary = b[0] == 0xFF ? "an empty slot" : fmt::format("{} reachable frames", code.code.size());
+    r.bytes = b;
+    if (b[0] != 0xFF) check_calls(l, layout, code, nullptr, {}, "written");
+  } else {
+    const auto& d = *src.document;
+    const auto c = to_program(d, robot, layout, board_period(l), src.rescale);
+    if (!ok(c))
+      throw refused(refusal_kind::usage,
+                    fmt::format("{}: {} (nothing was written)", src.name, std::get<problem>(c).message));
+    const auto& cm = std::get<compiled_motion>(c);
+    auto b = mo::assemble(cm.program, where);
+    if (!mo::ok(b))
+      throw refused(refusal_kind::usage,
+                    fmt::format("{}: {} (nothing was written)", src.name, std::get<mo::failure>(b).message));
+    r.bytes = std::move(std::get<std::vector<std::uint8_t>>(b));
+    r.notes = cm.notes;
+    code = mo::disassemble(r.bytes, where);
+    check_calls(l, layout, code, &cm.program, d.where, "written");
+    std::size_t poses = 0;
+    unsigned frames = 0;
+    for (const auto& st : cm.program.steps)
+      if (const auto* p = std::get_if<mo::pose>(&st)) ++poses, frames += p->time.value();
+    r.summary = fmt::format("{} steps, {} pose{} ({:.2f} s of moves)", cm.program.steps.size(), poses,
+                            poses == 1 ? "" : "s", frames * rcb4::milliseconds(cm.period) / 1000.0);
+  }
+  if (dry_run) return r;
+  const auto old = read_rom(l, r.address, where.size, fmt::format("backing up motion {}", n));
+  require_writable(l, layout, n, old, "written");
+  if (std::equal(r.bytes.begin(), r.bytes.end(), old.begin())) {
+    r.unchanged = true;
+    return r;
+  }
+  r.backup = backup(n, old);
+  write_rom_checked(l, r.address, r.bytes, fmt::format("writing motion {}", n), n, r.backup);
+  return r;
+}
+
+erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup) {
+  const auto where = slot_for(layout, n);
+  erase_report r{n, where.address.value(), where.size, false, {}};
+  const auto old = read_rom(l, r.address, where.size, fmt::format("backing up motion {}", n));
+  require_writable(l, layout, n, old, "erased");
+  if (std::all_of(old.begin(), old.end(), [](std::uint8_t b) { return b == 0xFF; })) {
+    r.unchanged = true;
+    return r;
+  }
+  r.backup = backup(n, old);
+  const std::vector<std::uint8_t> erased(where.size, 0xFF);
+  write_rom_checked(l, r.address, erased, fmt::format("erasing motion {}", n), n, r.backup);
+  return r;
+}
+
+pull_report pull_motion(link& l, const model& robot, const rom_layout& layout, unsigned n) {
+  const auto where = slot_for(layout, n);
+  pull_report r;
+  r.motion = n;
+  r.address = where.address.value();
+  r.layout = layout.name;
+  const auto bytes = read_rom(l, r.address, where.size, fmt::format("reading motion {}", n));
+  if (bytes.empty() || bytes[0] == 0xFF)
+    throw refused(refusal_kind::board, fmt::format("motion {} (0x{:06X}) is empty: erased ROM", n, r.address),
+                  "rcb4 motion list shows the used slots");
+  const auto code = mo::disassemble(bytes, where);
+  if (!code.problems.empty())
+    throw refused(refusal_kind::board, fmt::format("motion {}: {}", n, code.problems.front()),
+                  fmt::format("rcb4 motion show {} lists the code the board reaches", n));
+  r.bytes = code_size(code);
+  const auto p = mo::lift(code);
+  if (!mo::ok(p))
+    throw refused(refusal_kind::board,
+                  fmt::format("motion {} is code a motion file cannot say: {}", n, std::get<mo::failure>(p).message),
+                  fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n, r.address,
+                              r.bytes));
+  r.period = board_period(l);
+  r.document = from_program(std::get<mo::program>(p), robot, layout, r.period);
+  r.document.name = std::string(robot.motion(n));
+  // Checked as a push will check it: a pose beyond a limit pulls, but does not push back as it is.
+  const auto again = to_program(r.document, robot, layout, r.period);
+  if (!ok(again)) r.beyond = std::get<problem>(again).message;
+  for (const auto& st : r.document.steps)
+    if (const auto* mp = std::get_if<motion_pose>(&st)) ++r.poses, r.pose_ms += mp->time.count();
+  return r;
+}
+
+}  // namespace rcb4::robot::services
