@@ -19,8 +19,9 @@ from ._core import (  # noqa: F401
     UsageError,
     __version__,
     load_pose,
+    move_refusal,
     save_pose,
 )
 
-__all__ = ["Board", "ControlLoop", "load_pose", "save_pose", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
+__all__ = ["Board", "ControlLoop", "load_pose", "save_pose", "move_refusal", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
            "__version__"]

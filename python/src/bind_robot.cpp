@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "common.hpp"
 
+#include <rcb4/robot/services/moves.hpp>
+
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -270,6 +272,17 @@ The reads are planned once for the link; nothing is allocated per cycle in C++.)
           "The RAM reads the planner chose for this link: (address, size) each.")
       .def_property_readonly("slots", &control_loop::slots, "The ICS numbers a write sends, ascending.");
 
+  m.def(
+      "move_refusal",
+      [](const py::dict& state) -> std::optional<std::string> {
+        rcb4::ops::motion_state st;
+        st.running = state.contains("running") && state["running"].cast<bool>();
+        if (state.contains("motion") && !state["motion"].is_none()) st.motion = state["motion"].cast<unsigned>();
+        return rcb4::robot::services::move_refusal(st);
+      },
+      "state"_a,
+      "Why a move must not be sent while the board is in @p state (a motion_status() dict): the words the tool, "
+      "rcb4 ui and Board.move use; None when it may.");
   m.def(
       "load_pose",
       [](const py::object& path, const std::string& robot) {

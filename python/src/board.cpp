@@ -4,6 +4,7 @@
 
 #include <rcb4/motion/buttons.hpp>
 #include <rcb4/ops/layout.hpp>
+#include <rcb4/robot/services/moves.hpp>
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
 #include <rcb4/transport/tcp.hpp>
@@ -150,10 +151,9 @@ void board::refuse_if_motion_runs(const char* what) {
   rcb4::ops::read_motion_state op;
   t::run(c(what), op, ec);
   if (ec) raise(ec, what);
-  if (op.value().running && op.value().motion)
-    throw board_error(fault::refused, std::string(what) + ": motion " + std::to_string(*op.value().motion) +
-                                          " is running on the board: it would overwrite the move, so nothing was "
-                                          "sent (stop_motion() or wait_motion() first)");
+  // The one rule (rcb4/robot/services/moves.hpp).
+  if (const auto why = rcb4::robot::services::move_refusal(op.value()))
+    throw board_error(fault::refused, std::string(what) + ": " + *why + " (stop_motion() or wait_motion() first)");
 }
 
 template <class Op>
@@ -287,8 +287,11 @@ void board::play_motion(unsigned n) {
   const auto& l = layout();
   if (n < 1 || n > l.motion_count)
     throw board_error(fault::usage, "motion " + std::to_string(n) + " is outside 1.." + std::to_string(l.motion_count));
+  check_playable(n, "play_motion");  // an empty or broken slot would stop the board's program
   run(rcb4::ops::play_motion(n, l, rcb4::ops::servo_power::keep), "play the motion");
 }
+
+rcb4::output_period board::period() { return run(rcb4::ops::read_config{}, "read the config word").period; }
 
 void board::stop_motion() { run(rcb4::ops::stop_motion{}, "stop the motion"); }
 

@@ -7,6 +7,9 @@
 #include <rcb4/ops.hpp>
 #include <rcb4/robot/ops.hpp>
 #include <rcb4/robot/profile.hpp>
+#include <rcb4/robot/services/buttons.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/rom.hpp>
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/io_thread.hpp>
@@ -126,9 +129,44 @@ class board {
   /** Sends servos by ICS number to positions (FREE, HOLD or 0..16383) over @p frames, in one CONST. */
   void move_servos(const rcb4::servo_set<rcb4::servo_position>& targets, unsigned frames);
 
+  // The robot services (rcb4/robot/services/), as the tool runs them (board_services.cpp).
+  /** Motion @p n's slot: its bytes and its code as the board runs it. */
+  std::pair<std::vector<std::uint8_t>, rcb4::motion::listing> show_motion(unsigned n);
+  /** Motion @p n as a motion file's document. */
+  rcb4::robot::services::pull_report pull_motion(unsigned n);
+  /** Writes @p src into motion @p n (the old bytes to @p backup, or motion-N-DATE.bin here). */
+  rcb4::robot::services::push_report push_motion(const rcb4::robot::services::push_source& src, unsigned n,
+                                                 const std::string& backup, bool dry_run);
+  /** Empties motion @p n, its old bytes saved first. */
+  rcb4::robot::services::erase_report erase_motion(unsigned n, const std::string& backup);
+  /** Both copies of the button table. */
+  rcb4::robot::services::button_tables buttons();
+  /** @p word plays motion @p n. */
+  rcb4::robot::services::table_report set_button(std::uint16_t word, unsigned n);
+  /** @p word plays nothing. */
+  rcb4::robot::services::table_report clear_button(std::uint16_t word);
+  /** Presses @p word as a receiver would. */
+  rcb4::robot::services::press_report press(std::uint16_t word, bool hold);
+  /** Releases every button. */
+  void release();
+  /** The whole ROM. */
+  std::vector<std::uint8_t> rom_backup();
+  /** Writes @p image where it differs; the replaced ROM saved by @p save. */
+  rcb4::robot::services::restore_report rom_restore(std::span<const std::uint8_t> image,
+                                                    const rcb4::robot::services::rom_sink& save, bool force);
+  /** The board's VERSION text and output period (for files the services write). */
+  rcb4::output_period period();
+  /** The layout told from the ROM (cached). */
+  const rcb4::rom_layout& rom_layout() { return layout(); }
+
  private:
   template <class Op>
   auto run(Op op, const char* what);
+  /** Refuses (BoardRefused) a play of motion @p n when its slot is empty or broken. */
+  void check_playable(unsigned n, const char* what);
+  /** Runs @p f(link) on the line: the services' refusals become board_error, a failed line its fault. */
+  template <class F>
+  auto service(const char* what, F&& f);
   client& c(const char* what);
   rcb4::ops::link_cost link(const char* what);
   void refuse_if_motion_runs(const char* what);

@@ -68,5 +68,7 @@ inline std::string path_of(const py::object& path) {
 
 /** Adds poses, trims, scan and the control loop to Board (bind_robot.cpp). */
 void bind_robot(py::module_& m, py::class_<board>& cls);
+/** Adds the robot services to Board: motion slots, buttons, the ROM (bind_services.cpp). */
+void bind_services(py::class_<board>& cls);
 
 }  // namespace pyrcb4

@@ -326,4 +326,5 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "battery_volts, ad (AD0..AD10 as read), ad_volts (each x 5 V / 1024: the 10-bit 0-5 V input; AD0 is the "
           "supply divided by 5), pio_direction, pio_value, buttons, button_names, pa (PA1..PA4).");
   bind_robot(m, cls);
+  bind_services(cls);
 }

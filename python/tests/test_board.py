@@ -296,7 +296,7 @@ def test_what_a_newcomer_found(board, tmp_path):
     # Too long a move is a limit, an empty slot the board lacking it.
     with pytest.raises(pyrcb4.LimitError, match="255 output periods"):
         board.move({"left_knee": 5}, time=3.0)
-    with pytest.raises(pyrcb4.BoardRefused, match="no program"):
+    with pytest.raises(pyrcb4.BoardRefused, match="holds no motion"):
         board.play_motion(7)
     # load_pose's result plays as it is; numpy integers are numbers; bytes-likes write.
     pyrcb4.save_pose(tmp_path / "p.json", {"left_knee": 12}, time=0.1)

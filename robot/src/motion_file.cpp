@@ -393,6 +393,42 @@ std::string motion_yaml(const motion_document& d, std::string_view comment) {
   return out;
 }
 
+namespace {
+/** A YAML node as JSON: plain scalars that read as integers, numbers or booleans become them. */
+nlohmann::ordered_json to_json(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Sequence: {
+      auto out = nlohmann::ordered_json::array();
+      for (const auto& item : n) out.push_back(to_json(item));
+      return out;
+    }
+    case YAML::NodeType::Map: {
+      auto out = nlohmann::ordered_json::object();
+      for (const auto& kv : n) out[kv.first.as<std::string>()] = to_json(kv.second);
+      return out;
+    }
+    case YAML::NodeType::Scalar: {
+      const auto& text = n.Scalar();
+      if (n.Tag() != "!") {  // a plain scalar (a quoted one is a string whatever it holds)
+        long long i = 0;
+        if (const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), i);
+            ec == std::errc{} && end == text.data() + text.size())
+          return i;
+        double d = 0;
+        if (YAML::convert<double>::decode(n, d) && !text.empty() &&
+            (std::isdigit(static_cast<unsigned char>(text[0])) || text[0] == '-' || text[0] == '+' || text[0] == '.'))
+          return d;
+        if (text == "true" || text == "false") return text == "true";
+      }
+      return text;
+    }
+    default: return nullptr;
+  }
+}
+}  // namespace
+
+std::string motion_json(const motion_document& d) { return to_json(YAML::Load(motion_yaml(d))).dump(); }
+
 void save_motion(const std::filesystem::path& path, const motion_document& d, std::string_view comment) {
   const auto ext = path.extension().string();
   if (ext != ".yaml" && ext != ".yml") throw profile_error(path.string(), "a motion file ends in .yaml or .yml");

@@ -97,7 +97,7 @@ expect_ok(["motion", "status"], "no motion running")
 expect_ok(["motion", "stop"], "stopped")
 expect_ok(["motion", "resume"], "resumed")
 expect_rc(["motion", "play", "121"], 2, "outside 1..120")
-expect_rc(["motion", "play", "120"], 1, "holds no program")  # an erased slot: refused before anything changes
+expect_rc(["motion", "play", "120"], 1, "holds no motion")  # an erased slot: refused before anything changes
 expect_ok(["motion", "status"], "no motion running")
 expect_rc(["motion", "play", "1", "--layout", "9.9"], 2, "--layout")
 expect_ok(["bench", "--count", "20"], "KHR-3HV cycle (20 joints")
@@ -309,7 +309,7 @@ short = StandIn(mode="short")
 rc, out, err = run("--device", short.path, "--baud", "1250000", "read", "ram", "0", "4")
 check(rc == 1, f"replies of the wrong length: exit 1, a board/line problem (rc {rc}: {err[:200]!r})")
 rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3", "--layout", "2.2")
-check(rc == 1 and "holds no program" in err, f"stand-in with an erased ROM: motion play refused (rc {rc}: {err[:160]!r})")
+check(rc == 1 and "motion 3 (0x001B80) holds no motion" in err, f"stand-in with an erased ROM: motion play refused (rc {rc}: {err[:160]!r})")
 rc, out, err = run("--device", empty.path, "--baud", "1250000", "motion", "play", "3")
 check(rc == 1 and "cannot tell which HeartToHeart4 layout" in err,
       f"stand-in with an erased ROM: its layout is not guessed (rc {rc}: {err[:160]!r})")

@@ -15,6 +15,7 @@ import os
 import sys
 import tempfile
 import time
+import zlib
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import check, finish, tool
@@ -176,5 +177,68 @@ with serve("--period", "15") as dev:
     check(rc == 2 and "more than 4 MiB" in err and took < 5, f"a 50 MB motion file refused by its size in {took:.2f} s ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "play", "huge.yaml")
     check(rc == 2 and "more than 4 MiB" in err, f"motion play of it too ({rc}: {err.strip()!r})")
+
+# The ROM restored: the button table the board compares (RAM) follows it, so what `buttons` lists
+# is what a press does and what `buttons clear` removes; an image that is no RCB-4 program is
+# refused unless forced, even with --no-check.
+
+def with_crc(name, data):
+    with open(name, "wb") as f:
+        f.write(data)
+    with open(name + ".crc32", "w") as f:
+        f.write(f"{zlib.crc32(data):08x}  {name}\n")
+
+
+with serve() as dev:
+    on = ["--device", dev]
+    rc, out, err = run(*on, "motion", "buttons", "set", "s2+down", "2")
+    rc2, out2, err2 = run(*on, "rom", "backup", "with-s2.bin")
+    check(rc == 0 and rc2 == 0, f"s2+down plays motion 2; ROM backed up ({rc} {rc2}: {err.strip()!r} {err2.strip()!r})")
+    run(*on, "motion", "buttons", "reset")
+    rc, out, err = run(*on, "rom", "restore", "with-s2.bin")
+    rc2, b, _ = run("--json", *on, "motion", "buttons")
+    b = json.loads(b) if rc2 == 0 else {}
+    ram = [e["buttons"] for e in b.get("ram", {}).get("entries", [])]
+    check(rc == 0 and "the button table the board compares (RAM) now is the restored one" in out
+          and b.get("same") is True and "down+s2" in ram,
+          f"rom restore: RAM's table is the restored one, RAM and ROM the same ({rc}: {out.strip()!r} {ram} {b.get('same')})")
+    rc, out, err = run(*on, "motion", "buttons", "clear", "s2+down")
+    rc2, b, _ = run("--json", *on, "motion", "buttons")
+    b = json.loads(b) if rc2 == 0 else {}
+    lists = [e["buttons"] for t in ("ram", "rom") for e in b.get(t, {}).get("entries", [])]
+    check(rc == 0 and "down+s2" not in lists and b.get("same") is True,
+          f"buttons clear after a restore removes what buttons lists ({rc}: {err.strip()!r})")
+    # An entry only RAM holds (ROM's table erased by hand): listed, and cleared.
+    run(*on, "motion", "buttons", "set", "s3", "1")
+    run(*on, "write", "rom", "0x091B", "FF " * 16)
+    rc2, b, _ = run("--json", *on, "motion", "buttons")
+    b = json.loads(b) if rc2 == 0 else {}
+    listed = [e["buttons"] for e in b.get("ram", {}).get("entries", [])]
+    rc, out, err = run(*on, "motion", "buttons", "clear", "s3")
+    rc3, b2, _ = run("--json", *on, "motion", "buttons")
+    b2 = json.loads(b2) if rc3 == 0 else {}
+    check("s3" in listed and rc == 0 and "s3" not in [e["buttons"] for e in b2.get("ram", {}).get("entries", [])],
+          f"an entry only RAM holds is cleared ({listed} {rc}: {err.strip()!r} {b2.get('ram')})")
+    # Images that are no RCB-4 program.
+    good = open("with-s2.bin", "rb").read()
+    with_crc("erased.bin", b"\xff" * len(good))
+    no_motion1 = bytearray(good)
+    no_motion1[0x0B80:0x0B80 + 0x800] = b"\xff" * 0x800
+    with_crc("nomotion1.bin", bytes(no_motion1))
+    no_boot = bytearray(good)
+    no_boot[0:16] = b"\xff" * 16
+    with_crc("noboot.bin", bytes(no_boot))
+    rc0, before, _ = run("--json", *on, "read", "rom", "0", "16")
+    for name, words in (("erased.bin", "no boot code at 0x000000"), ("nomotion1.bin", "its HTH4 layout cannot be told"),
+                        ("noboot.bin", "no boot code")):
+        for extra in ([], ["--no-check"]):
+            rc, out, err = run(*on, "rom", "restore", name, *extra)
+            check(rc == 2 and "not a plausible RCB-4 ROM" in err and words in err and "--force" in err,
+                  f"rom restore {name} {' '.join(extra)}: refused, exit 2 ({rc}: {err.strip()!r})")
+    rc1, after, _ = run("--json", *on, "read", "rom", "0", "16")
+    check(rc0 == 0 and before == after, "nothing was written")
+    rc, out, err = run(*on, "rom", "restore", "nomotion1.bin", "--force")
+    check(rc == 0 and "wrote" in out and rom(on, SLOT, 4) == b"\xff" * 4,
+          f"--force writes it all the same ({rc}: {out.strip()!r} {err.strip()!r})")
 
 finish()

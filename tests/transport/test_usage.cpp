@@ -5,6 +5,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "served_board.hpp"
 
+#include <rcb4/transport/adapters.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/serial.hpp>
 
@@ -15,9 +16,13 @@
 #include <boost/asio/experimental/awaitable_operators.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/thread_pool.hpp>
+
 #include <boost/asio/use_awaitable.hpp>
 #include <boost/asio/use_future.hpp>
 #include <catch2/catch.hpp>
+#include <fstream>
+#include <iterator>
+#include <string>
 
 #include <atomic>
 #include <thread>
@@ -315,4 +320,49 @@ TEST_CASE("usage: a program between io.poll() calls destroys its client with an 
   CHECK(clock_type::now() - start < 1s);  // no freeze of turnaround + 1 s
   io.run();                               // the next run ends it
   CHECK(called);
+}
+
+// KONDO's USB ids, as ics.md §6 lists them (written here by hand from the table).
+static_assert(t::find_kondo_adapter(0x165C, 0x0008)->line == t::adapter_line::com_or_ics);
+static_assert(t::find_kondo_adapter(0x165C, 0x0002)->line == t::adapter_line::com);
+static_assert(t::find_kondo_adapter(0x165C, 0x0005)->line == t::adapter_line::com);
+static_assert(t::find_kondo_adapter(0x165C, 0x0007)->line == t::adapter_line::com);
+static_assert(t::find_kondo_adapter(0x165C, 0x0001)->line == t::adapter_line::ics);
+static_assert(t::find_kondo_adapter(0x165C, 0x0006)->line == t::adapter_line::ics);
+static_assert(t::find_kondo_adapter(0x165C, 0x0009)->line == t::adapter_line::not_servos);
+static_assert(!t::find_kondo_adapter(0x165C, 0x000A));
+static_assert(!t::find_kondo_adapter(0x0403, 0x6001));  // a plain FTDI chip is not KONDO's
+
+namespace {
+/** The digits of the idProduct=="000[...]" pattern on the first line of @p rule that holds @p marker. */
+std::string products_on(const std::string& rule, std::string_view marker) {
+  std::size_t at = rule.find(marker);
+  if (at == std::string::npos) return {};
+  const auto start = rule.rfind("\n\n", at);  // the rule's paragraph: its lines continue with a backslash
+  const auto end = rule.find("\n\n", at);
+  const auto para =
+      rule.substr(start == std::string::npos ? 0 : start, end == std::string::npos ? std::string::npos : end - start);
+  const std::string key = "ATTRS{idProduct}==\"000[";
+  const auto k = para.find(key);
+  if (k == std::string::npos) return {};
+  return para.substr(k + key.size(), para.find(']', k) - k - key.size());
+}
+}  // namespace
+
+TEST_CASE("usage: the udev rule names every KONDO adapter that carries an RCB-4's COM or ICS line",
+          "[transport][usage]") {
+  std::ifstream in(RCB4_SOURCE_DIR "/cmake/udev/60-rcb4.rules");
+  REQUIRE(in);
+  const std::string rule{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto bind = products_on(rule, "new_id"), tty = products_on(rule, "SUBSYSTEM==\"tty\""),
+             latency = products_on(rule, "latency_timer");
+  for (const auto& a : t::kondo_adapters) {
+    if (a.line == t::adapter_line::not_servos) continue;
+    INFO(a.name);
+    const char digit = static_cast<char>('0' + a.product);
+    CHECK(tty.find(digit) != std::string::npos);
+    CHECK(latency.find(digit) != std::string::npos);
+    // The kernel's ftdi_sio table has 0002 itself; every other one is bound by new_id.
+    CHECK((bind.find(digit) != std::string::npos) == (a.product != 0x0002));
+  }
 }

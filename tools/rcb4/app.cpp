@@ -297,15 +297,14 @@ session_link::~session_link() = default;
 rcb4::reply session_link::exchange(const rcb4::command& c) {
   rcb4::transport::error_code ec;
   last_.emplace(s_.c().exchange(c, ec));
-  if (ec) throw rcb4::transport::system_error(ec);
+  if (ec) {  // the services take std::system_error (Boost 1.81 carries the category across)
+    const std::error_code code(ec);
+    throw std::system_error(code, std::string(plain_message(rcb4::transport::system_error(ec).what())));
+  }
   return last_->view();
 }
 
-void session_link::failed(rcb4::errc e) {
-  rcb4::transport::error_code ec;
-  ec = e;
-  throw rcb4::transport::system_error(ec);
-}
+void session_link::failed(rcb4::errc e) { throw std::system_error(make_error_code(e), std::string(rcb4::message(e))); }
 
 void session_link::progress(std::string_view label, std::size_t done, std::size_t total) {
   if (!bar_ || label != label_) {

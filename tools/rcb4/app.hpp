@@ -179,9 +179,9 @@ class session_link final : public rcb4::robot::services::link {
   ~session_link() override;
   session_link(const session_link&) = delete;
   session_link& operator=(const session_link&) = delete;
-  /** One exchange through the session's client; a failed line throws rcb4::transport::system_error. */
+  /** One exchange through the session's client; a failed line throws std::system_error. */
   rcb4::reply exchange(const rcb4::command& c) override;
-  /** Throws rcb4::transport::system_error(@p e). */
+  /** Throws std::system_error(@p e). */
   [[noreturn]] void failed(rcb4::errc e) override;
   /** A progress line per label, cleared when the label changes. */
   void progress(std::string_view label, std::size_t done, std::size_t total) override;

@@ -3,43 +3,19 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
-#include <rcb4/robot/services/motion_slots.hpp>
-
 #include <rcb4/motion/buttons.hpp>
 #include <rcb4/ops/layout.hpp>
+#include <rcb4/robot/services/buttons.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 
 namespace cli {
 namespace {
 
 namespace mo = rcb4::motion;
-namespace tl = rcb4::motion::vector_table_layout;
+namespace sv = rcb4::robot::services;
 using rcb4::ops::memory;
 
-/** Both copies of the table: RAM (what the board compares now) and ROM (what it loads at power-on). */
-struct tables {
-  std::uint16_t ram_at = 0;  ///< RAM 0x008C: where the board looks
-  std::uint16_t rom_at = 0;  ///< ROM 0x0919: what power-on writes to 0x008C
-  mo::vector_table ram, rom;
-  std::vector<std::uint8_t> ram_bytes, rom_bytes;
-};
-
-tables read_tables(session& s) {
-  tables t;
-  const auto a = s.run(rcb4::ops::read_memory(memory::ram, rcb4::ram::vector_table.value(), 2));
-  t.ram_at = static_cast<std::uint16_t>(a[0] | (a[1] << 8));
-  const auto r = s.run(rcb4::ops::read_memory(memory::rom, tl::rom_address_word.value(), 2 + tl::bytes));
-  t.rom_at = static_cast<std::uint16_t>(r[0] | (r[1] << 8));
-  t.rom_bytes.assign(r.begin() + 2, r.end());
-  t.rom = mo::decode_vector_table(t.rom_bytes);
-  if (std::uint32_t{t.ram_at} + rcb4::vector_entry::size <= rcb4::ram_size) {
-    const auto n = std::min<std::size_t>(tl::bytes, rcb4::ram_size - t.ram_at);
-    t.ram_bytes = s.run(rcb4::ops::read_memory(memory::ram, t.ram_at, n));
-    t.ram = mo::decode_vector_table(t.ram_bytes);
-  } else {
-    t.ram.problem = fmt::format("its address 0x{:04X} (RAM 0x008C) is outside RAM: no HTH4 project loaded", t.ram_at);
-  }
-  return t;
-}
+using tables = sv::button_tables;
 
 /** "motion 2 (wave)" for a slot start of @p layout, else the address. */
 std::string target_text(std::uint32_t a, const rcb4::rom_layout& layout, const rcb4::robot::model& robot) {
@@ -99,20 +75,18 @@ json table_json(const mo::vector_table& t, const rcb4::rom_layout& layout) {
   return json{{"entries", entries}, {"problem", t.problem.empty() ? json(nullptr) : json(t.problem)}};
 }
 
-/** RAM and ROM hold the same entries. */
-bool same(const tables& t) { return t.ram.entries == t.rom.entries && t.ram.problem.empty() == t.rom.problem.empty(); }
-
 int show(session& s, const motion_options& o, const globals& g) {
   const auto& layout = layout_for(s, o);
   const auto& robot = robot_of(g);
-  const auto t = read_tables(s);
+  session_link link(s, g.json);
+  const auto t = sv::read_buttons(link);
   const auto cfg = s.run(rcb4::ops::read_config{});
   if (g.json) {
     emit(json{{"layout", layout.name},
               {"table_address", t.ram_at},
               {"ram", table_json(t.ram, layout)},
               {"rom", table_json(t.rom, layout)},
-              {"same", same(t)},
+              {"same", t.same()},
               {"vector_switch", cfg.vector_jump},
               {"rom_program", cfg.rom_program}});
     return exit_ok;
@@ -121,7 +95,7 @@ int show(session& s, const motion_options& o, const globals& g) {
   for (const auto& e : t.ram.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
   if (t.ram.entries.empty())
     fmt::print("  no entries{}\n", t.ram.problem.empty() ? "" : fmt::format(": {}", t.ram.problem));
-  if (!same(t)) {
+  if (!t.same()) {
     fmt::print("ROM (what the board loads at power-on) differs:\n");
     for (const auto& e : t.rom.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
     if (t.rom.entries.empty())
@@ -132,44 +106,21 @@ int show(session& s, const motion_options& o, const globals& g) {
   return exit_ok;
 }
 
-/** Writes @p entries to ROM (image and its address word) and RAM (what the board compares now), then reads both back.
- */
-int write_table(session& s, const tables& before, std::vector<rcb4::vector_entry> entries, const std::string& what,
-                const rcb4::rom_layout& layout, const globals& g) {
-  for (std::size_t j = 0; j < entries.size(); ++j) entries[j].last = j + 1 == entries.size();  // as encoded: EOF last
-  const auto bytes = mo::encode_vector_table(entries);
-  if (!mo::ok(bytes)) throw failure(exit_board, std::get<mo::failure>(bytes).message);
-  const auto& b = std::get<std::vector<std::uint8_t>>(bytes);
-  const std::uint16_t at = tl::ram_entries.value();
-  const std::array<std::uint8_t, 2> at_bytes = {static_cast<std::uint8_t>(at & 0xFF),
-                                                static_cast<std::uint8_t>(at >> 8)};
-  s.run(rcb4::ops::write_memory(memory::rom, tl::rom_entries.value(), b));
-  if (before.rom_at != at) s.run(rcb4::ops::write_memory(memory::rom, tl::rom_address_word.value(), at_bytes));
-  s.run(rcb4::ops::write_memory(memory::ram, at, b));
-  if (before.ram_at != at) s.run(rcb4::ops::write_memory(memory::ram, rcb4::ram::vector_table.value(), at_bytes));
-  const auto after = read_tables(s);
-  if (after.rom.entries != entries || after.ram.entries != entries)
-    throw failure(exit_board,
-                  fmt::format("the table read back is not what was written ({} differs)",
-                              after.rom.entries != entries ? "ROM" : "RAM"),
-                  "the board may not accept ROM writes (write-protected, or another program rewrites the table)");
+/** Prints what a table write did (the service wrote and read back both copies). */
+int print_table(const sv::table_report& r, const rcb4::rom_layout& layout, const globals& g) {
   if (g.json) {
-    emit(json{{"done", what}, {"layout", layout.name}, {"entries", table_json(after.rom, layout)["entries"]}});
+    json entries = json::array();
+    for (const auto& e : r.entries) entries.push_back(entry_json(e, layout));
+    emit(json{
+        {"done", r.done}, {"layout", layout.name}, {"entries", entries}, {"ram_followed_rom", r.ram_followed_rom}});
   } else {
-    fmt::print("{}; the table now (RAM and ROM, read back):\n", what);
-    for (const auto& e : after.rom.entries) fmt::print("  {}\n", entry_text(e, layout, robot_of(g)));
-    if (after.rom.entries.empty()) fmt::print("  no entries\n");
+    fmt::print("{}; the table now (RAM and ROM, read back):\n", r.done);
+    for (const auto& e : r.entries) fmt::print("  {}\n", entry_text(e, layout, robot_of(g)));
+    if (r.entries.empty()) fmt::print("  no entries\n");
+    if (r.ram_followed_rom)
+      fmt::print("(RAM held other entries than ROM: it now holds ROM's, as after a power cycle)\n");
   }
   return exit_ok;
-}
-
-/** The table to edit: ROM's (what survives power-off); erased ROM is an empty table, anything else unreadable is
- * refused. */
-std::vector<rcb4::vector_entry> editable(const tables& t) {
-  if (!t.rom.problem.empty() && !(t.rom.entries.empty() && !t.rom_bytes.empty() && t.rom_bytes[0] == 0xFF))
-    throw failure(exit_board, fmt::format("the vector table in ROM (0x091B) cannot be read: {}", t.rom.problem),
-                  "rcb4 read rom 0x091B 256 shows it; rcb4 motion buttons reset writes an empty table");
-  return t.rom.entries;
 }
 
 std::uint16_t buttons_of(const std::string& text) {
@@ -181,16 +132,8 @@ std::uint16_t buttons_of(const std::string& text) {
 }  // namespace
 
 std::vector<std::string> entries_playing(session& s, std::uint32_t address) {
-  std::vector<std::string> out;
-  const auto t = read_tables(s);
-  for (const auto* table : {&t.rom, &t.ram})
-    for (const auto& e : table->entries)
-      if (e.target.value() == address) {
-        const auto b = e.buttons();
-        std::string what = b ? mo::buttons_text(*b) : fmt::format("an entry on {}", operand_text(e.dst));
-        if (std::find(out.begin(), out.end(), what) == out.end()) out.push_back(std::move(what));
-      }
-  return out;
+  session_link link(s, true);
+  return sv::entries_playing(sv::read_buttons(link), address);
 }
 
 void add_button_commands(CLI::App* motion, context& ctx) {
@@ -222,20 +165,9 @@ void add_button_commands(CLI::App* motion, context& ctx) {
   on_device(set, ctx, [&ctx, o, so](session& s) {
     const auto word = buttons_of(so->buttons);
     const auto& layout = layout_for(s, *o);
-    if (so->n > layout.motion_count)
-      throw usage_error(fmt::format("N: {} is outside 1..{} ({} layout)", so->n, layout.motion_count, layout.name));
-    const auto n = static_cast<unsigned>(so->n);
-    const auto target = rcb4::motion_address(layout, n).value();
-    {  // an empty or broken slot (as motion list marks it) would stop the board's program
-      session_link link(s, ctx.g.json);
-      rcb4::robot::services::require_playable(link, layout, n,
-                                              fmt::format("a button playing motion {}", n));
-    }
-    const auto t = read_tables(s);
-    auto entries = mo::assign_button(editable(t), word, target);
-    if (!mo::ok(entries)) throw failure(exit_board, std::get<mo::failure>(entries).message);
-    return write_table(s, t, std::get<std::vector<rcb4::vector_entry>>(entries),
-                       fmt::format("{} plays motion {}", mo::buttons_text(word), n), layout, ctx.g);
+    sv::slot_for(layout, so->n);
+    session_link link(s, ctx.g.json);
+    return print_table(sv::set_button(link, layout, word, static_cast<unsigned>(so->n)), layout, ctx.g);
   });
 
   auto co = std::make_shared<std::string>();
@@ -245,12 +177,8 @@ void add_button_commands(CLI::App* motion, context& ctx) {
   on_device(clear, ctx, [&ctx, o, co](session& s) {
     const auto word = buttons_of(*co);
     const auto& layout = layout_for(s, *o);
-    const auto t = read_tables(s);
-    auto entries = mo::clear_button(editable(t), word);
-    if (!entries)
-      throw failure(exit_board, fmt::format("no entry plays anything for {}", mo::buttons_text(word)),
-                    "rcb4 motion buttons lists the entries");
-    return write_table(s, t, *entries, fmt::format("{} plays nothing", mo::buttons_text(word)), layout, ctx.g);
+    session_link link(s, ctx.g.json);
+    return print_table(sv::clear_button(link, word), layout, ctx.g);
   });
 
   struct press_options {
@@ -268,68 +196,25 @@ void add_button_commands(CLI::App* motion, context& ctx) {
   on_device(press, ctx, [&ctx, o, po](session& s) {
     const auto word = buttons_of(po->buttons);
     const auto& layout = layout_for(s, *o);
-    // What the board would do, from the table it compares (RAM): nothing, or a call of an empty
-    // slot (which stops its program), is said before anything is pressed.
-    const auto t = read_tables(s);
-    const rcb4::vector_entry* entry = nullptr;
-    for (const auto& e : t.ram.entries)
-      if (e.buttons() == word) {
-        entry = &e;
-        break;
-      }
-    const bool plays = entry || std::any_of(t.ram.entries.begin(), t.ram.entries.end(),
-                                            [](const auto& e) { return !e.buttons(); });
-    if (!plays && !po->hold)
-      throw failure(exit_board,
-                    fmt::format("no entry of the table plays anything for {}: a press would only be seen by a "
-                                "motion that tests the buttons",
-                                mo::buttons_text(word)),
-                    "--hold holds them as a receiver would (for a motion's if_buttons); rcb4 motion buttons set "
-                    "BUTTONS N adds an entry");
-    if (entry) {
-      const std::uint32_t a = entry->target.value(), base = layout.motion_base.value();
-      const bool slot = a >= base && (a - base) % layout.slot_size == 0 && (a - base) / layout.slot_size < layout.motion_count;
-      if (slot) {  // an empty or broken slot (as motion list marks it) would stop the board's program
-        session_link link(s, ctx.g.json);
-        rcb4::robot::services::require_playable(link, layout, (a - base) / layout.slot_size + 1,
-                                                fmt::format("{} plays it", mo::buttons_text(word)));
-      } else if (!rcb4::ops::detail::holds_frame(s.run(rcb4::ops::read_memory(memory::rom, a, 128)))) {
-        throw failure(exit_board,
-                      fmt::format("{} plays {}, which holds no motion: a press would stop the board's program",
-                                  mo::buttons_text(word), target_text(a, layout, robot_of(ctx.g))),
-                      fmt::format("rcb4 motion buttons clear {}, or rcb4 motion push FILE N into that slot",
-                                  mo::buttons_text(word)));
-      }
-    }
-    const auto bytes = rcb4::krr::encode_buttons(word);
-    s.run(rcb4::ops::write_memory(memory::ram, rcb4::krr::buttons.value(), bytes));
-    if (!plays) {  // held as a receiver would hold them: only a motion's button test sees them
+    session_link link(s, ctx.g.json);
+    const auto r = sv::press(link, layout, word, po->hold);
+    const auto& st = r.state;
+    if (!r.entry) {
       if (ctx.g.json)
         emit(json{{"pressed", mo::buttons_text(word)}, {"motion", nullptr}, {"held", true}, {"entry", false}});
       else
-        fmt::print("{} held (no entry of the table plays anything for them; a motion's if_buttons sees them) until "
-                   "rcb4 motion buttons release\n",
-                   mo::buttons_text(word));
+        fmt::print(
+            "{} held (no entry of the table plays anything for them; a motion's if_buttons sees them) until "
+            "rcb4 motion buttons release\n",
+            mo::buttons_text(word));
       return exit_ok;
     }
-    // The board compares the table once per output period (10-25 ms): a motion runs within a few.
-    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(1);
-    rcb4::ops::motion_state st;
-    do {
-      st = s.run(rcb4::ops::read_motion_state(layout));
-    } while (!st.running && std::chrono::steady_clock::now() < until);
-    if (!po->hold) {
-      static constexpr std::array<std::uint8_t, 2> neutral{};
-      s.run(rcb4::ops::write_memory(memory::ram, rcb4::krr::buttons.value(), neutral));
-    }
-    if (!st.running)
-      throw failure(exit_board, fmt::format("{} pressed for 1 s: no motion started", mo::buttons_text(word)),
-                    "rcb4 motion buttons shows which buttons play what, and whether the ROM program runs");
     if (ctx.g.json)
       emit(json{{"pressed", mo::buttons_text(word)},
                 {"motion", st.motion ? json(*st.motion) : json(nullptr)},
                 {"program_counter", st.program_counter},
-                {"held", po->hold}});
+                {"held", po->hold},
+                {"entry", true}});
     else
       fmt::print(
           "{} pressed: {} runs{}\n", mo::buttons_text(word),
@@ -340,8 +225,8 @@ void add_button_commands(CLI::App* motion, context& ctx) {
 
   auto* release = buttons->add_subcommand("release", "release every button (the button word at 0x0350 to 0)");
   on_device(release, ctx, [&ctx](session& s) {
-    static constexpr std::array<std::uint8_t, 2> neutral{};
-    s.run(rcb4::ops::write_memory(memory::ram, rcb4::krr::buttons.value(), neutral));
+    session_link link(s, ctx.g.json);
+    sv::release(link);
     if (ctx.g.json)
       emit(json{{"released", true}});
     else
@@ -352,8 +237,8 @@ void add_button_commands(CLI::App* motion, context& ctx) {
   auto* reset = buttons->add_subcommand("reset", "an empty table: no button plays anything (ROM and RAM)");
   on_device(reset, ctx, [&ctx, o](session& s) {
     const auto& layout = layout_for(s, *o);
-    const auto t = read_tables(s);
-    return write_table(s, t, {}, "no button plays anything", layout, ctx.g);
+    session_link link(s, ctx.g.json);
+    return print_table(sv::reset_buttons(link), layout, ctx.g);
   });
 }
 

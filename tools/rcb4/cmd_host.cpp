@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/transport/adapters.hpp>
+
 #include <rcb4/transport/cpu_latency.hpp>
 #include <rcb4/transport/detect.hpp>
 
@@ -58,8 +60,11 @@ std::vector<port_info> find_ports() {
     std::ifstream t(sysfs() / "bus/usb-serial/devices" / name / "latency_timer");
     unsigned ms = 0;
     if (t >> ms) p.latency = ms;
-    if (p.vid == "165c" && p.pid == "0008")
-      p.kind = "KONDO Dual USB Adapter HS (RCB-4 / ICS)";
+    const auto id = [](const std::string& hex) {
+      return static_cast<std::uint16_t>(hex.empty() ? 0 : std::strtoul(hex.c_str(), nullptr, 16));
+    };
+    if (const auto a = rcb4::transport::find_kondo_adapter(id(p.vid), id(p.pid)))
+      p.kind = fmt::format("KONDO {} ({})", a->name, rcb4::transport::line_text(a->line));
     else if (p.vid == "165c")
       p.kind = "KONDO USB device";
     else if (p.vid == "0403")
@@ -150,7 +155,8 @@ int doctor(const globals& g) {
   } else {
     report(!ports.empty(),
            ports.empty() ? "no USB serial adapter found" : fmt::format("{} USB serial port(s) found", ports.size()),
-           "plug in the KONDO adapter (165C:0008) or the FTDI cable; `dmesg | tail` should show it; "
+           "plug in the KONDO adapter (165C:0002, 0005, 0007 or 0008 for the RCB-4) or the FTDI cable; `dmesg | tail` "
+           "should show it; "
            "without hardware use the virtual board (rcb4 ping, no --device)");
     for (const auto& p : ports) candidates.push_back(p.path);
   }
@@ -227,7 +233,8 @@ void add_host_commands(CLI::App& app, context& ctx) {
   auto* list_cmd = app.add_subcommand("list", "serial ports, recognising KONDO's adapter and FTDI");
   list_cmd->footer(
       "Lists USB serial ports (ttyUSB*, ttyACM*) with their USB ids, recognising KONDO's adapter\n"
-      "(165C:0008) and FTDI chips, and the FTDI latency timer (1 ms is best for the RCB-4).");
+      "(165C:0001, 0002, 0005-0008: which carries the RCB-4 COM line and which ICS) and FTDI chips,\n"
+      "and the FTDI latency timer (1 ms is best for the RCB-4).");
   on_run(list_cmd, ctx, [&ctx] { return list(ctx.g); });
 
   auto* doctor_cmd = app.add_subcommand("doctor", "check permissions, dialout, udev rule, latency timer, baud");

@@ -183,8 +183,8 @@ int erase(session& s, const push_options& o, const globals& g) {
       fmt::print("motion {} (0x{:06X}) is already empty: nothing written\n", n, r.address);
     return exit_ok;
   }
-  warn_buttons(s, mo::slot_of(layout, n).value(), n, "a press now stops the board's program (rcb4 motion buttons clear)",
-               g);
+  warn_buttons(s, mo::slot_of(layout, n).value(), n,
+               "a press now stops the board's program (rcb4 motion buttons clear)", g);
   // Motion 1 is where the layout is told from: without it, --layout must say it.
   const std::string again = n == 1 && o.m.layout == "auto" ? fmt::format(" --layout {}", layout_flag(layout)) : "";
   if (!again.empty() && !g.json)

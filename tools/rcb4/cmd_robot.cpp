@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/robot/services/moves.hpp>
+
 #include <cerrno>
 #include <cmath>
 #include <filesystem>
@@ -98,14 +100,9 @@ sent_moves move(session& s, const robot::model& m, std::vector<robot::joint_move
   std::vector<const robot::joint*> need;
   for (const auto& mv : moves) need.push_back(mv.j);
   const auto map = locate(s, m, need);
-  // A ROM motion that runs writes the outputs every frame: a move now would be overwritten at once.
-  // Only a motion counts: the program counter in a motion slot with the ROM program on (a move's
-  // own interpolation also sets the update flags; a stopped motion leaves its PC behind, §8.2).
-  if (const auto state = s.run(rcb4::ops::read_motion_state{}); state.running && state.motion)
-    throw failure(exit_board,
-                  fmt::format("motion {} is running on the board: it would overwrite the move, so nothing was sent",
-                              *state.motion),
-                  "rcb4 motion wait lets it finish; rcb4 motion stop suspends it");
+  // The one rule (rcb4/robot/services/moves.hpp): no move while a ROM motion runs.
+  if (const auto why = rcb4::robot::services::move_refusal(s.run(rcb4::ops::read_motion_state{})))
+    throw failure(exit_board, *why, "rcb4 motion wait lets it finish; rcb4 motion stop suspends it");
   robot::move_joints op(std::move(moves));
   rcb4::transport::error_code ec;
   s.run_steps(op, ec, [] {});

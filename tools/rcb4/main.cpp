@@ -233,8 +233,11 @@ int main(int argc, char** argv) {
   } catch (const cli::failure& f) {
     return fail(ctx.g, chosen(app), f);
   } catch (const rcb4::robot::services::refused& r) {
-    return fail(ctx.g, chosen(app), cli::failure(cli::exit_of(r.kind), r.what(), r.hint,
-                                                r.backup.empty() ? cli::json() : cli::json{{"backup", r.backup}}));
+    // A line that failed part way: its exit code and, when the service has no better one, its hint.
+    auto f = r.code ? cli::explain(r.code, r.what()) : cli::failure(cli::exit_of(r.kind), r.what());
+    if (!r.hint.empty()) f.hint = r.hint;
+    if (!r.backup.empty()) f.extra = cli::json{{"backup", r.backup}};
+    return fail(ctx.g, chosen(app), f);
   } catch (const std::system_error& e) {
     return fail(ctx.g, chosen(app), cli::explain(e.code(), e.what()));
   } catch (const boost::system::system_error& e) {

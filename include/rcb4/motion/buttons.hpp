@@ -56,14 +56,16 @@ inline std::string buttons_text(std::uint16_t word) {
   std::uint16_t rest = word;
   for (const auto& b : button_names)
     if (word & b.bit) {
-      out += (out.empty() ? "" : "+") + std::string(b.name);
+      if (!out.empty()) out += '+';  // appended piece by piece: GCC 12's -Wrestrict misfires on "+" + string at -O2
+      out += b.name;
       rest = static_cast<std::uint16_t>(rest & ~b.bit);
     }
   if (rest != 0) {
     static constexpr char hex[] = "0123456789ABCDEF";
     std::string h = "0x";
     for (int s = 12; s >= 0; s -= 4) h += hex[(rest >> s) & 0xF];
-    out += (out.empty() ? "" : "+") + h;
+    if (!out.empty()) out += '+';
+    out += h;
   }
   return out.empty() ? "none" : out;
 }

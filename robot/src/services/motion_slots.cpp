@@ -25,7 +25,8 @@ namespace mo = rcb4::motion;
 std::string first_problem(const mo::listing& code) {
   std::string p = code.problems.front();
   constexpr std::string_view tail = ": the board stops here";
-  if (p.size() > tail.size() && p.compare(p.size() - tail.size(), tail.size(), tail) == 0) p.resize(p.size() - tail.size());
+  if (p.size() > tail.size() && p.compare(p.size() - tail.size(), tail.size(), tail) == 0)
+    p.resize(p.size() - tail.size());
   return p;
 }
 using rcb4::ops::memory;
@@ -150,9 +151,9 @@ std::string chain_text(const rom_layout& layout, const std::vector<std::uint32_t
 void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> bytes, std::string_view label,
                        unsigned n, const std::string& saved) {
   const std::string undo =
-      saved.empty() ? std::string()
-                    : fmt::format("the slot's old bytes are in {}: rcb4 motion push {} {} puts them back", saved,
-                                  saved, n);
+      saved.empty()
+          ? std::string()
+          : fmt::format("the slot's old bytes are in {}: rcb4 motion push {} {} puts them back", saved, saved, n);
   rcb4::ops::write_memory op(memory::rom, at, bytes);
   try {
     while (auto c = op.next()) {
@@ -160,21 +161,18 @@ void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> 
       l.progress(label, op.value(), bytes.size());
     }
     if (op.error() != errc{}) l.failed(op.error());
-  } catch (const refused&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw refused(refusal_kind::board,
-                  fmt::format("writing ROM 0x{:06X} failed after {} of {} bytes: {}", at, op.value(), bytes.size(),
-                              e.what()),
-                  "the slot may now hold part of the new motion; " + undo, saved);
+  } catch (const std::system_error& e) {
+    throw refused(
+        refusal_kind::line,
+        fmt::format("writing ROM 0x{:06X} failed after {} of {} bytes: {}", at, op.value(), bytes.size(), e.what()),
+        "the slot may now hold part of the new motion; " + undo, saved, e.code());
   }
   std::vector<std::uint8_t> back;
   try {
     back = read_rom(l, at, bytes.size(), "reading back");
-  } catch (const std::exception& e) {
-    throw refused(refusal_kind::board,
-                  fmt::format("reading back ROM 0x{:06X} after the write failed: {}", at, e.what()),
-                  "the slot holds what was written, unchecked; " + undo, saved);
+  } catch (const std::system_error& e) {
+    throw refused(refusal_kind::line, fmt::format("reading back ROM 0x{:06X} after the write failed: {}", at, e.what()),
+                  "the slot holds what was written, unchecked; " + undo, saved, e.code());
   }
   for (std::size_t i = 0; i < bytes.size(); ++i)
     if (back[i] != bytes[i])
@@ -202,10 +200,10 @@ std::string save_backup_file(unsigned motion, std::span<const std::uint8_t> old,
   out.write(reinterpret_cast<const char*>(old.data()), static_cast<std::streamsize>(old.size()));
   out.flush();
   if (!out)
-    throw refused(refusal_kind::usage,
-                  fmt::format("cannot write the backup {}: {} (nothing was written to the board)", path,
-                              std::strerror(errno)),
-                  "name another place for the backup");
+    throw refused(
+        refusal_kind::usage,
+        fmt::format("cannot write the backup {}: {} (nothing was written to the board)", path, std::strerror(errno)),
+        "name another place for the backup");
   return path;
 }
 
@@ -292,11 +290,11 @@ void require_writable(link& l, const rom_layout& layout, unsigned n, std::span<c
                                         "motion), which starts the program afresh; then write"
                                       : "rcb4 motion play N (any motion) starts the program afresh; then write";
   if (st.motion && *st.motion == n)
-    throw refused(refusal_kind::board,
-                  fmt::format("motion {} {} (program counter 0x{:06X}): {} in the middle of the bytes being {}", n,
-                              state, st.program_counter,
-                              st.running ? "the board would run on" : "motion resume would continue", doing),
-                  hint);
+    throw refused(
+        refusal_kind::board,
+        fmt::format("motion {} {} (program counter 0x{:06X}): {} in the middle of the bytes being {}", n, state,
+                    st.program_counter, st.running ? "the board would run on" : "motion resume would continue", doing),
+        hint);
   mo::listing own{where, {}, {}, {}, {}};
   if (!old.empty() && old[0] != 0xFF) own = mo::disassemble(old, where);
   rom_code rom(l, layout, &own);
@@ -305,8 +303,7 @@ void require_writable(link& l, const rom_layout& layout, unsigned n, std::span<c
     throw refused(refusal_kind::board,
                   fmt::format("the board's program {} in {}, which motion {} called: a return into motion {} is on "
                               "the board's call stack ({} levels), so {} would return into the bytes being {}",
-                              state, pc_name, n, n, st.depth,
-                              st.running ? "the program" : "motion resume", doing),
+                              state, pc_name, n, n, st.depth, st.running ? "the program" : "motion resume", doing),
                   hint);
   // A running motion that calls this slot would run it while it is written.
   const auto pc_slot = slot_number(layout, st.program_counter);
@@ -325,12 +322,12 @@ void require_playable(link& l, const rom_layout& layout, unsigned n, std::string
   rom_code rom(l, layout, nullptr);
   const auto& c = rom.at(where.address.value());
   if (c.problems.empty()) return;
-  throw refused(refusal_kind::board,
-                fmt::format("{}: motion {} (0x{:06X}) {}: a play would stop the board's program there", what, n,
-                            where.address.value(),
-                            c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")"),
-                c.code.empty() ? "rcb4 motion list shows the used slots"
-                               : fmt::format("rcb4 motion show {} lists its code; push it again", n));
+  throw refused(
+      refusal_kind::board,
+      fmt::format("{}: motion {} (0x{:06X}) {}: a play would stop the board's program there", what, n,
+                  where.address.value(), c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")"),
+      c.code.empty() ? "rcb4 motion list shows the used slots"
+                     : fmt::format("rcb4 motion show {} lists its code; push it again", n));
 }
 
 namespace {
@@ -425,10 +422,10 @@ pull_report pull_motion(link& l, const model& robot, const rom_layout& layout, u
   r.bytes = code_size(code);
   const auto p = mo::lift(code);
   if (!mo::ok(p))
-    throw refused(refusal_kind::board,
-                  fmt::format("motion {} is code a motion file cannot say: {}", n, std::get<mo::failure>(p).message),
-                  fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n, r.address,
-                              r.bytes));
+    throw refused(
+        refusal_kind::board,
+        fmt::format("motion {} is code a motion file cannot say: {}", n, std::get<mo::failure>(p).message),
+        fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n, r.address, r.bytes));
   r.period = board_period(l);
   r.document = from_program(std::get<mo::program>(p), robot, layout, r.period);
   r.document.name = std::string(robot.motion(n));

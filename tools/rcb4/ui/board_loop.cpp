@@ -4,6 +4,7 @@
 
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/robot/motion_file.hpp>
+#include <rcb4/robot/services/moves.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -275,9 +276,9 @@ class loop {
   }
 
   void refuse_during_motion() {
-    if (motion_.running && motion_.motion && rom_program_)
-      throw refusal{
-          fmt::format("motion {} is running on the board: stop it first (the move would fight it)", *motion_.motion)};
+    // The one rule (rcb4/robot/services/moves.hpp), on the state this loop keeps.
+    if (!rom_program_) return;
+    if (const auto why = rcb4::robot::services::move_refusal(motion_)) throw refusal{*why + " (stop it first)"};
   }
 
   /** The longest move the board makes: 255 frames of its output period (protocol.md §5). */

@@ -100,6 +100,12 @@ motion_document parse_motion(std::string_view text, const std::string& source, c
 motion_document load_motion(const std::filesystem::path& path, const model& m);
 /** The motion as YAML text, a step per item, in the form parse_motion reads. */
 std::string motion_yaml(const motion_document& d, std::string_view comment = {});
+/**
+ * The motion as one JSON object with the keys of its YAML ("robot", "name", "period_ms", "steps":
+ * a step per item), for programs that hold steps as data (pyrcb4): JSON is YAML too, so the text
+ * parse_motion reads back is json.dumps of it.
+ */
+std::string motion_json(const motion_document& d);
 /** Writes motion_yaml(@p d) to @p path (.yaml or .yml). Throws profile_error. */
 void save_motion(const std::filesystem::path& path, const motion_document& d, std::string_view comment = {});
 

@@ -211,10 +211,10 @@ class Rcb4Node:
                 due = self.trajectory.pop(0)
             stream, self.stream = self.stream, None
         motion = self.last_motion or {}
-        # A ROM motion in its slot (servos still moving from our own last command set the same flags: no motion).
-        if (due or stream is not None) and motion.get("running") and motion.get("motion") is not None:
-            rospy.logerr_throttle(1.0, f"rcb4: motion {motion.get('motion')} is running on the board: it "
-                                       "would fight the command, so nothing was sent (~stop_motion first)")
+        # The one rule for a move during a ROM motion (rcb4/robot/services/moves.hpp, through pyrcb4).
+        refusal = pyrcb4.move_refusal(motion) if (due or stream is not None) else None
+        if refusal:
+            rospy.logerr_throttle(1.0, f"rcb4: {refusal} (~stop_motion first)")
             with self.lock:
                 self.trajectory = []
             return

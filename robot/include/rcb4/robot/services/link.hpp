@@ -31,23 +31,25 @@ enum class refusal_kind {
   board,  ///< the board's state forbids it (a motion runs, a slot is broken): tool exit 1, pyrcb4 BoardRefused
   usage,  ///< the request or its file is wrong (a bad number, a file that does not read): exit 2, UsageError
   limit,  ///< a joint would go beyond its limit: exit 2, LimitError
+  line,   ///< the line failed part way through a workflow (refused::code says how): exit 3 or 4, DeviceError
 };
 
 /** A workflow that did not do what it was asked, and why; nothing was written unless the message says so. */
 struct refused : std::runtime_error {
   /** @p message says what and why, @p fix what to do (optional), @p saved a backup the workflow had saved. */
-  refused(refusal_kind k, std::string message, std::string fix = {}, std::string saved = {})
-      : std::runtime_error(std::move(message)), kind(k), hint(std::move(fix)), backup(std::move(saved)) {}
-  refusal_kind kind;   ///< how the front end reports it
-  std::string hint;    ///< what to do about it, or empty
-  std::string backup;  ///< the backup file of what the workflow had begun to replace, or empty
+  refused(refusal_kind k, std::string message, std::string fix = {}, std::string saved = {}, std::error_code why = {})
+      : std::runtime_error(std::move(message)), kind(k), hint(std::move(fix)), backup(std::move(saved)), code(why) {}
+  refusal_kind kind;     ///< how the front end reports it
+  std::string hint;      ///< what to do about it, or empty
+  std::string backup;    ///< the backup file of what the workflow had begun to replace, or empty
+  std::error_code code;  ///< for refusal_kind::line: the line's error (a timeout, an unplugged device)
 };
 
 /** The board, one exchange at a time, as the front end reaches it (a client, a board in-process, a UART). */
 class link {
  public:
   virtual ~link() = default;
-  /** Sends @p c and returns its reply (valid until the next call); throws when the line fails. */
+  /** Sends @p c and returns its reply (valid until the next call); throws std::system_error when the line fails. */
   virtual reply exchange(const command& c) = 0;
   /** An operation failed (a NACK, a malformed reply): throws; the default throws std::system_error. */
   [[noreturn]] virtual void failed(errc e) { throw std::system_error(make_error_code(e)); }

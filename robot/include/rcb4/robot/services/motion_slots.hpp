@@ -45,23 +45,23 @@ std::size_t code_size(const motion::listing& code);
 
 /** What a push did. */
 struct push_report {
-  unsigned motion = 0;             ///< the slot's number
-  std::uint32_t address = 0;       ///< its first byte
-  std::string layout;              ///< the layout's name
+  unsigned motion = 0;              ///< the slot's number
+  std::uint32_t address = 0;        ///< its first byte
+  std::string layout;               ///< the layout's name
   std::vector<std::uint8_t> bytes;  ///< what was written (or would be, for a dry run)
-  bool unchanged = false;          ///< the slot already held them: nothing written
-  bool dry_run = false;            ///< checked and assembled only
-  std::string backup;              ///< where the slot's old bytes are (empty when nothing was written)
-  std::string summary;             ///< "6 steps, 5 poses (1.50 s of moves)", or a .bin's content
-  std::vector<std::string> notes;  ///< what the motion does that may not be meant
+  bool unchanged = false;           ///< the slot already held them: nothing written
+  bool dry_run = false;             ///< checked and assembled only
+  std::string backup;               ///< where the slot's old bytes are (empty when nothing was written)
+  std::string summary;              ///< "6 steps, 5 poses (1.50 s of moves)", or a .bin's content
+  std::vector<std::string> notes;   ///< what the motion does that may not be meant
 };
 
 /** What a push writes: a motion file's document, or a backup's bytes put back as they are. */
 struct push_source {
   std::optional<motion_document> document;  ///< a motion file, read by load_motion
-  std::vector<std::uint8_t> bin;             ///< or a slot's bytes (a backup), when no document
-  std::string name;                          ///< the file's name, for messages
-  bool rescale = false;                      ///< keep the file's times in ms on another output period
+  std::vector<std::uint8_t> bin;            ///< or a slot's bytes (a backup), when no document
+  std::string name;                         ///< the file's name, for messages
+  bool rescale = false;                     ///< keep the file's times in ms on another output period
 };
 
 /**
@@ -75,11 +75,11 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
 
 /** What an erase did. */
 struct erase_report {
-  unsigned motion = 0;               ///< the slot's number
-  std::uint32_t address = 0;         ///< its first byte
-  std::uint32_t size = 0;            ///< bytes set to 0xFF
-  bool unchanged = false;            ///< it was already empty
-  std::string backup;                ///< where its old bytes are
+  unsigned motion = 0;        ///< the slot's number
+  std::uint32_t address = 0;  ///< its first byte
+  std::uint32_t size = 0;     ///< bytes set to 0xFF
+  bool unchanged = false;     ///< it was already empty
+  std::string backup;         ///< where its old bytes are
 };
 
 /** Empties motion @p n (0xFF, as erased ROM reads), its old bytes saved by @p backup first; refused as a push is. */
@@ -87,15 +87,15 @@ erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const b
 
 /** What a pull read. */
 struct pull_report {
-  unsigned motion = 0;          ///< the slot's number
-  std::uint32_t address = 0;    ///< its first byte
-  std::string layout;           ///< the layout's name
-  std::size_t bytes = 0;        ///< the code's size
-  motion_document document;     ///< the motion as a file says it
-  std::size_t poses = 0;        ///< poses in it
-  long long pose_ms = 0;        ///< their times, summed (one pass)
-  output_period period{};       ///< the board's output period
-  std::string beyond;           ///< why the file would not push back as it is (a pose beyond a limit), or empty
+  unsigned motion = 0;        ///< the slot's number
+  std::uint32_t address = 0;  ///< its first byte
+  std::string layout;         ///< the layout's name
+  std::size_t bytes = 0;      ///< the code's size
+  motion_document document;   ///< the motion as a file says it
+  std::size_t poses = 0;      ///< poses in it
+  long long pose_ms = 0;      ///< their times, summed (one pass)
+  output_period period{};     ///< the board's output period
+  std::string beyond;         ///< why the file would not push back as it is (a pose beyond a limit), or empty
 };
 
 /** Reads motion @p n into a document (named from the profile); refused when empty, broken or not expressible. */

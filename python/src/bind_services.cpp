@@ -1,0 +1,289 @@
+// pyrcb4: the robot services on Board, bound to Python: motion slots (show, pull, push, erase),
+// the remote's buttons (read, set, clear, press, release), the whole ROM (backup, restore). The
+// rules are the library's (rcb4/robot/services/): the same refusals as the rcb4 tool, as
+// BoardRefused, UsageError and LimitError.
+// SPDX-License-Identifier: BSL-1.0
+#include "common.hpp"
+
+#include <rcb4/fmt.hpp>
+#include <rcb4/motion/buttons.hpp>
+#include <rcb4/robot/motion_file.hpp>
+
+#include <pybind11/stl.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace pyrcb4 {
+namespace sv = rcb4::robot::services;
+namespace mo = rcb4::motion;
+using namespace pybind11::literals;
+
+namespace {
+
+/** A button word from "s1+up" or an int. */
+std::uint16_t button_word(const py::object& buttons) {
+  if (py::isinstance<py::bool_>(buttons)) throw board_error(fault::usage, "buttons: a name such as 's1+up', or a word");
+  if (py::isinstance<py::int_>(buttons)) {
+    const auto v = buttons.cast<long long>();
+    if (v < 1 || v > 0xFFFF || (v & ~rcb4::krr::valid_buttons))
+      throw board_error(fault::usage, "buttons: " + std::to_string(v) + " is not a button word");
+    return static_cast<std::uint16_t>(v);
+  }
+  if (!py::isinstance<py::str>(buttons)) throw board_error(fault::usage, "buttons: a name such as 's1+up', or a word");
+  const auto b = mo::parse_buttons(buttons.cast<std::string>());
+  if (!mo::ok(b)) throw board_error(fault::usage, "buttons: " + std::get<mo::failure>(b).message);
+  return std::get<std::uint16_t>(b);
+}
+
+/** A motion number, checked before anything is read. */
+unsigned motion_number(long long n) {
+  if (n < 1 || n > 120) throw board_error(fault::usage, "motion " + std::to_string(n) + " is outside 1..120");
+  return static_cast<unsigned>(n);
+}
+
+/** A motion document as Python data: {"robot", "name", "period_ms", "steps": [...]}, as a motion file says it. */
+py::object document_data(const rcb4::robot::motion_document& d) {
+  return py::module_::import("json").attr("loads")(rcb4::robot::motion_json(d));
+}
+
+py::list entries_data(const std::vector<rcb4::vector_entry>& entries, const rcb4::rom_layout& layout) {
+  py::list out;
+  for (const auto& e : entries) {
+    const auto b = e.buttons();
+    const std::uint32_t a = e.target.value(), base = layout.motion_base.value();
+    const bool slot =
+        a >= base && (a - base) % layout.slot_size == 0 && (a - base) / layout.slot_size < layout.motion_count;
+    out.append(
+        py::dict("buttons"_a = b ? py::object(py::str(mo::buttons_text(*b))) : py::object(py::none()),
+                 "button_word"_a = b ? py::object(py::int_(*b)) : py::object(py::none()),
+                 "action"_a = e.action == rcb4::vector_action::call ? "call" : "jump", "address"_a = a,
+                 "motion"_a = slot ? py::object(py::int_((a - base) / layout.slot_size + 1)) : py::object(py::none())));
+  }
+  return out;
+}
+
+py::dict table_data(const sv::table_report& r, const rcb4::rom_layout& layout) {
+  return py::dict("done"_a = r.done, "entries"_a = entries_data(r.entries, layout),
+                  "ram_followed_rom"_a = r.ram_followed_rom);
+}
+
+}  // namespace
+
+void bind_services(py::class_<board>& cls) {
+  cls.def(
+         "show_motion",
+         [](board& b, long long n) {
+           const auto k = motion_number(n);
+           auto [bytes, code] = unlocked([&] { return b.show_motion(k); });
+           py::list listing;
+           for (const auto& in : code.code)
+             listing.append(py::dict("address"_a = in.address, "hex"_a = fmt::format("{}", rcb4::hex_view{in.bytes}),
+                                     "text"_a = in.cmd ? fmt::format("{}", *in.cmd) : std::string("(not a frame)")));
+           const bool empty = bytes.empty() || bytes[0] == 0xFF;
+           return py::dict("motion"_a = k, "address"_a = code.where.address.value(), "empty"_a = empty,
+                           "code"_a = empty ? py::list() : listing,
+                           "problems"_a = empty ? std::vector<std::string>{} : code.problems, "notes"_a = code.notes,
+                           "calls"_a = code.calls);
+         },
+         "n"_a,
+         "Motion n's code as the board runs it: code (address, hex, text of each frame), problems (what stops the "
+         "board), notes, calls (the addresses it calls); empty for erased ROM.")
+      .def(
+          "pull_motion",
+          [](board& b, long long n, const py::object& path, bool force) {
+            const auto k = motion_number(n);
+            std::string p;
+            if (!path.is_none()) {
+              p = path_of(path);
+              const auto ext = std::filesystem::path(p).extension();
+              if (ext != ".yaml" && ext != ".yml")
+                throw board_error(fault::usage, "path: " + p + " does not end in .yaml or .yml");
+              if (std::filesystem::exists(p) && !force)
+                throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
+            }
+            const auto r = unlocked([&] { return b.pull_motion(k); });
+            if (!p.empty()) {
+              try {
+                rcb4::robot::save_motion(p, r.document,
+                                         fmt::format("motion {} of the board (0x{:06X}, {} layout), pulled by pyrcb4",
+                                                     k, r.address, r.layout));
+              } catch (const rcb4::robot::profile_error& e) {
+                throw board_error(fault::usage, e.what());
+              }
+            }
+            auto d = document_data(r.document);
+            d["motion"] = k;
+            d["address"] = r.address;
+            d["bytes"] = r.bytes;
+            d["poses"] = r.poses;
+            d["beyond"] = r.beyond.empty() ? py::object(py::none()) : py::object(py::str(r.beyond));
+            d["file"] = p.empty() ? py::object(py::none()) : py::object(py::str(p));
+            return d;
+          },
+          "n"_a, "path"_a = py::none(), "force"_a = false,
+          "Motion n as a motion file says it: {robot, name, period_ms, steps, ...}; with path, also written there "
+          "(.yaml; force=True replaces a file). beyond: why it would not push back as it is (a pose beyond a limit).")
+      .def(
+          "push_motion",
+          [](board& b, const py::object& what, long long n, const py::object& backup, bool rescale, bool dry_run) {
+            const auto k = motion_number(n);
+            sv::push_source src;
+            src.rescale = rescale;
+            if (py::isinstance<py::list>(what) || py::isinstance<py::dict>(what)) {
+              // Steps as data (a list, or the dict pull_motion gives): JSON is YAML, so the motion-file parser reads
+              // them.
+              py::dict doc;
+              if (py::isinstance<py::dict>(what)) {
+                for (const auto& kv : what.cast<py::dict>()) {
+                  const auto key = kv.first.cast<std::string>();
+                  if (key == "robot" || key == "name" || key == "period_ms" || key == "steps")
+                    doc[kv.first] = kv.second;
+                }
+              } else {
+                doc["steps"] = what;
+              }
+              if (!doc.contains("robot")) doc["robot"] = b.robot().name();
+              if (!doc.contains("period_ms"))  // times in ms of this board's period
+                doc["period_ms"] = rcb4::milliseconds(unlocked([&] { return b.period(); }));
+              const auto text = py::module_::import("json").attr("dumps")(doc).cast<std::string>();
+              try {
+                src.document = rcb4::robot::parse_motion(text, "steps", b.robot());
+              } catch (const rcb4::robot::profile_error& e) {
+                throw board_error(fault::usage, e.what());
+              }
+              src.name = "steps";
+            } else {
+              const auto p = path_of(what);
+              src.name = p;
+              if (std::filesystem::path(p).extension() == ".bin") {
+                std::ifstream in(p, std::ios::binary);
+                if (!in) throw board_error(fault::usage, "path: " + p + " cannot be read");
+                src.bin.resize(8193);
+                in.read(reinterpret_cast<char*>(src.bin.data()), static_cast<std::streamsize>(src.bin.size()));
+                src.bin.resize(static_cast<std::size_t>(in.gcount()));
+              } else {
+                try {
+                  src.document = rcb4::robot::load_motion(p, b.robot());
+                } catch (const rcb4::robot::profile_error& e) {
+                  throw board_error(fault::usage, e.what());
+                }
+              }
+            }
+            const std::string to = backup.is_none() ? std::string() : path_of(backup);
+            if (!to.empty() && std::filesystem::path(to).extension() != ".bin")
+              throw board_error(fault::usage, "backup: " + to + " does not end in .bin (push_motion puts a .bin back)");
+            const auto r = unlocked([&] { return b.push_motion(src, k, to, dry_run); });
+            return py::dict("motion"_a = r.motion, "address"_a = r.address, "layout"_a = r.layout,
+                            "bytes"_a = r.bytes.size(), "hex"_a = fmt::format("{}", rcb4::hex_view{r.bytes}),
+                            "unchanged"_a = r.unchanged, "dry_run"_a = r.dry_run,
+                            "backup"_a = r.backup.empty() ? py::object(py::none()) : py::object(py::str(r.backup)),
+                            "summary"_a = r.summary, "notes"_a = r.notes);
+          },
+          "what"_a, "n"_a, "backup"_a = py::none(), "rescale"_a = false, "dry_run"_a = false,
+          "Writes a motion file (.yaml), a backup (.bin), or steps (a list, or pull_motion's dict) into motion n: "
+          "checked, the old bytes saved to backup (a new .bin; default motion-N-DATE.bin here), written, read back. "
+          "Returns the report: address, bytes, backup, notes, ...")
+      .def(
+          "erase_motion",
+          [](board& b, long long n, const py::object& backup) {
+            const auto k = motion_number(n);
+            const std::string to = backup.is_none() ? std::string() : path_of(backup);
+            const auto r = unlocked([&] { return b.erase_motion(k, to); });
+            return py::dict("motion"_a = r.motion, "address"_a = r.address, "unchanged"_a = r.unchanged,
+                            "backup"_a = r.backup.empty() ? py::object(py::none()) : py::object(py::str(r.backup)));
+          },
+          "n"_a, "backup"_a = py::none(), "Empties motion n (0xFF), its old bytes saved to backup first.")
+      .def(
+          "buttons",
+          [](board& b) {
+            const auto& layout = unlocked([&]() -> const rcb4::rom_layout& { return b.rom_layout(); });
+            const auto t = unlocked([&] { return b.buttons(); });
+            return py::dict("ram"_a = entries_data(t.ram.entries, layout),
+                            "rom"_a = entries_data(t.rom.entries, layout), "same"_a = t.same());
+          },
+          "The button table: ram (what the board compares now), rom (what it loads at power-on), same.")
+      .def(
+          "set_button",
+          [](board& b, const py::object& buttons, long long n) {
+            const auto word = button_word(buttons);
+            const auto k = motion_number(n);
+            const auto& layout = unlocked([&]() -> const rcb4::rom_layout& { return b.rom_layout(); });
+            return table_data(unlocked([&] { return b.set_button(word, k); }), layout);
+          },
+          "buttons"_a, "n"_a, "buttons ('s1+up' or a word) play motion n, in ROM and RAM; returns the table.")
+      .def(
+          "clear_button",
+          [](board& b, const py::object& buttons) {
+            const auto word = button_word(buttons);
+            const auto& layout = unlocked([&]() -> const rcb4::rom_layout& { return b.rom_layout(); });
+            return table_data(unlocked([&] { return b.clear_button(word); }), layout);
+          },
+          "buttons"_a, "buttons play nothing any more (ROM and RAM); returns the table.")
+      .def(
+          "press",
+          [](board& b, const py::object& buttons, bool hold) {
+            const auto word = button_word(buttons);
+            const auto r = unlocked([&] { return b.press(word, hold); });
+            return py::dict(
+                "buttons"_a = mo::buttons_text(word), "entry"_a = r.entry, "held"_a = r.held,
+                "motion"_a = r.state.motion ? py::object(py::int_(*r.state.motion)) : py::object(py::none()),
+                "running"_a = r.state.running);
+          },
+          "buttons"_a, "hold"_a = false,
+          "Presses buttons as a KRR receiver would: until a motion starts, then released (hold=True: kept pressed; "
+          "buttons no entry plays are only held that way, for a motion's if_buttons).")
+      .def(
+          "release", [](board& b) { unlocked([&] { b.release(); }); }, "Releases every button.")
+      .def(
+          "rom_backup",
+          [](board& b, const py::object& path, bool force) {
+            const auto p = path_of(path);
+            if (std::filesystem::exists(p) && !force)
+              throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
+            const auto version = unlocked([&] { return b.version(); });
+            const auto image = unlocked([&] { return b.rom_backup(); });
+            try {
+              sv::save_rom_image(p, image, version);
+            } catch (const sv::refused& e) {
+              throw board_error(fault::usage, e.what());
+            }
+            return py::dict("file"_a = p, "bytes"_a = image.size(),
+                            "crc32"_a = fmt::format("{:08x}", sv::crc32(image)));
+          },
+          "path"_a, "force"_a = false,
+          "The whole ROM (262,144 bytes) into path, its CRC-32 into path.crc32 (as rcb4 rom backup writes them).")
+      .def(
+          "rom_restore",
+          [](board& b, const py::object& path, bool no_check, bool force) {
+            const auto p = path_of(path);
+            std::vector<std::uint8_t> image;
+            try {
+              image = sv::load_rom_image(p, no_check);
+            } catch (const sv::refused& e) {
+              throw board_error(fault::usage, e.what());
+            }
+            const auto version = unlocked([&] { return b.version(); });
+            const auto save = [&](std::span<const std::uint8_t> now) {
+              char stamp[32];
+              const std::time_t t = std::time(nullptr);
+              std::tm tm{};
+              ::localtime_r(&t, &tm);
+              std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+              const auto before =
+                  (std::filesystem::path(p).parent_path() / fmt::format("rom-before-restore-{}.bin", stamp)).string();
+              sv::save_rom_image(before, now, version);
+              return before;
+            };
+            const auto r = unlocked([&] { return b.rom_restore(image, save, force); });
+            return py::dict("pieces_written"_a = r.pieces, "unchanged"_a = r.unchanged,
+                            "before"_a = r.before.empty() ? py::object(py::none()) : py::object(py::str(r.before)),
+                            "buttons_loaded"_a = r.buttons_loaded, "program_stopped"_a = r.program_stopped);
+          },
+          "path"_a, "no_check"_a = false, "force"_a = false,
+          "Writes the image in path (from rom_backup or rcb4 rom backup) where it differs, each piece read back; the "
+          "ROM it replaces saved beside it first. Refused while a motion runs, for an image that is no RCB-4 program "
+          "(unless force=True), or one that fails its .crc32 (no_check=True: one without a .crc32).");
+}
+
+}  // namespace pyrcb4
