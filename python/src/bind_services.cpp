@@ -265,13 +265,9 @@ void bind_services(py::class_<board>& cls) {
             }
             const auto version = unlocked([&] { return b.version(); });
             const auto save = [&](std::span<const std::uint8_t> now) {
-              char stamp[32];
-              const std::time_t t = std::time(nullptr);
-              std::tm tm{};
-              ::localtime_r(&t, &tm);
-              std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
               const auto before =
-                  (std::filesystem::path(p).parent_path() / fmt::format("rom-before-restore-{}.bin", stamp)).string();
+                  (std::filesystem::path(p).parent_path() / fmt::format("rom-before-restore-{}.bin", sv::file_stamp()))
+                      .string();
               sv::save_rom_image(before, now, version);
               return before;
             };

@@ -82,7 +82,7 @@ board::board(const std::string& device, std::uint32_t baud, const std::string& r
     board_io_ = std::make_unique<t::io_thread>();
     server_ = t::board_server::serve_pty(board_io_->context(), *board_);
     path = server_->where();
-    where_ = "the in-process virtual board (" + path + ")";
+    where_ = "the in-process virtual board, a simulation (" + path + ")";
   } else {
     where_ = path;
   }

@@ -4,6 +4,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "common.hpp"
 
+#include <cstdlib>
+
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -72,6 +74,16 @@ std::unique_ptr<board> open_board(const py::object& device, const py::object& ba
       throw board_error(fault::usage, "device: a path such as '/dev/ttyUSB0', 'tcp:HOST:PORT', or None");
     path = path_of(device);
     if (path.empty()) throw board_error(fault::usage, "device: '' names no device (None is the virtual board)");
+  } else if (const char* env = std::getenv("RCB4_DEVICE")) {  // as the rcb4 tool takes it
+    if (!*env) throw board_error(fault::usage, "RCB4_DEVICE is set but empty (unset it for the virtual board)");
+    path = env;
+  } else {
+    // Said once per process: a script that meant a robot learns it drives a simulation.
+    static bool said = false;
+    if (!said) {
+      said = true;
+      PySys_WriteStderr("pyrcb4: no device given (and no $RCB4_DEVICE): an in-process virtual board, a simulation\n");
+    }
   }
   const std::uint32_t b = baud.is_none() ? 0u : baud.cast<std::uint32_t>();
   const auto ms = std::chrono::milliseconds(static_cast<long long>(std::ceil(timeout * 1000)));

@@ -9,7 +9,7 @@ import pytest
 
 # Under ASan the sanitizer runtime is preloaded into this Python (python.pytest_asan); the rcb4 tool
 # it starts carries its own: the preload is for this process only.
-os.environ.pop("LD_PRELOAD", None)
+PRELOAD = os.environ.pop("LD_PRELOAD", None)  # for a test's own Python subprocess (test_services.py)
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tests", "integration"))
 

@@ -168,3 +168,26 @@ def test_move_refusal_is_the_one_rule():
         "motion 3 is running on the board: it would overwrite the move, so nothing was sent")
     assert pyrcb4.move_refusal({"running": True, "motion": None}) is None
     assert pyrcb4.move_refusal({"running": False, "motion": 3}) is None
+
+
+def test_board_takes_rcb4_device_as_the_tool_does(served, monkeypatch):
+    monkeypatch.setenv("RCB4_DEVICE", served)
+    with pyrcb4.Board() as b:
+        assert served in b.where and b.ping() > 0
+    monkeypatch.setenv("RCB4_DEVICE", "")
+    with pytest.raises(pyrcb4.UsageError, match="RCB4_DEVICE is set but empty"):
+        pyrcb4.Board()
+
+
+def test_a_simulation_says_so_once():
+    import os
+    import subprocess
+    import sys
+    from conftest import PRELOAD
+    env = {k: v for k, v in os.environ.items() if k != "RCB4_DEVICE"}
+    if PRELOAD:  # a sanitized module needs its runtime in that Python too
+        env["LD_PRELOAD"] = PRELOAD
+    p = subprocess.run([sys.executable, "-c", "import pyrcb4\nb = pyrcb4.Board(); print(b.where); b.close()\n"
+                        "pyrcb4.Board().close()"], capture_output=True, text=True, env=env, timeout=60)
+    assert p.returncode == 0 and "a simulation" in p.stdout
+    assert p.stderr.count("an in-process virtual board, a simulation") == 1

@@ -214,7 +214,8 @@ motion_step parse_step(const std::string& source, const YAML::Node& n, const mod
 motion_document parse_motion_nodes(std::string_view text, const std::string& source, const model& m,
                                    const std::filesystem::path& dir) {
   const YAML::Node root = parse_yaml(text, source);
-  if (!root.IsMap()) throw profile_error(source, "a motion file is a mapping with robot, period_ms and steps");
+  if (!root.IsMap())
+    throw profile_error(source, "a motion file is a mapping with period_ms and steps (robot and name are optional)");
   check_keys(source, root, {"robot", "name", "period_ms", "steps"}, "motion");
   motion_document d;
   d.robot = m.name();

@@ -288,6 +288,16 @@ d = json.loads(run("--json", "decode", "07 0F 00 0A 4C 1D 89")[1])
 check(d["frames"][0]["kind"] == "request" and "SINGLE" in d["frames"][0]["meaning"] and d["bad"] == 0, "decode --json: objects, not strings of text")
 line = json.loads(run("--json", "monitor", "--count", "1")[1])
 check(len(line["ad"]) == 11 and len(line["pa"]) == 4 and line["time"] > 1.7e9 and "elapsed_s" in line, "monitor --json: AD0..AD10, PA1..PA4 and a timestamp")
+# monitor by the profile's joint names: every joint the board has, or those --joints names.
+check(len(line.get("joints", {})) == 20 and isinstance(line["joints"].get("left_knee"), float),
+      f"monitor --json: the KHR-3HV's 20 joints by name, in degrees ({line.get('joints')})")
+line = json.loads(run("--json", "monitor", "--count", "1", "--joints", "left_arm", "head_yaw")[1])
+check(set(line.get("joints", {})) == {"left_shoulder_pitch", "left_shoulder_roll", "left_elbow_yaw", "left_elbow_pitch", "head_yaw"},
+      f"monitor --joints left_arm head_yaw: those joints only ({sorted(line.get('joints', {}))})")
+rc, out, err = run("monitor", "--count", "1", "--joints", "left_knee")
+check(rc == 0 and "left_knee" in out and "ICS" not in out, f"monitor shows joint names ({rc}: {out.strip()[-200:]!r})")
+rc, out, err = run("monitor", "--count", "1", "--joints", "left_kneee")
+check(rc == 2 and "left_kneee" in err, f"monitor --joints with an unknown joint: exit 2 ({rc}: {err.strip()!r})")
 
 # ---- decode: the tool's own trace, invalid requests, the checksum it should have had -----------
 rc, out, err = run("--trace", "servo", "get", "0")

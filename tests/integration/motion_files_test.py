@@ -75,10 +75,18 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(rc == 0 and "motion 2 (0x001380, HTH4 2.2+ layout): 62 bytes, 6 steps, 5 poses" in out and "-> wave.yaml" in out,
           f"motion pull 2 ({rc}: {out.strip()!r} {err.strip()!r})")
     check('name: "wave"' in text and "period_ms: 15" in text
-          and "- pose: {right_shoulder_pitch: 67.5, right_shoulder_roll: 101.25}\n    time_ms: 300" in text,
+          and "- pose: {right_shoulder_pitch: 67.5, right_shoulder_roll: 94.5}\n    time_ms: 300" in text,
           f"the pulled file in degrees and ms ({text[:300]!r})")
-    check("would not push back" in err and "right_shoulder_roll: 101.25 degrees is beyond its upper limit 100" in err,
-          f"pull says a pose lies beyond the profile's limit ({err.strip()!r})")
+    check("would not push back" not in err, f"the demo's wave lies inside the profile's limits ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "wave.yaml", "2")
+    check(rc == 0 and "already holds these" in out, f"the pulled wave pushes back as it is, unchanged ({rc}: {out.strip()!r} {err.strip()!r})")
+    # A slot whose pose lies beyond a limit (written raw: CONST ICS 5 = 10500, +101.25 deg, 20
+    # frames, then RETURN; protocol.md §4-§5): pulled as it is, with the note.
+    run(*on, "write", "rom", "0x4380", "0B 10 20 00 00 00 00 14 04 29 7C 03 0D 10")
+    rc, out, err = run(*on, "motion", "pull", "8", "beyond.yaml")
+    check(rc == 0 and "would not push back" in err and "right_shoulder_roll: 101.25 degrees is beyond its upper limit 100" in err,
+          f"pull says a pose lies beyond the profile's limit ({rc}: {err.strip()!r})")
+    run(*on, "motion", "erase", "8", "--backup", "beyond8.bin")
     rc, out, err = run(*on, "motion", "pull", "2", "wave.yaml")
     check(rc == 2 and "exists (--force replaces it)" in err, f"pull does not overwrite a file ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "pull", "9", "empty.yaml")
@@ -87,8 +95,8 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(rc == 2 and ".yaml" in err, f"pull to a .txt: exit 2 ({rc}: {err.strip()!r})")
 
     # A pose beyond a limit: refused, nothing written, no backup made.
-    rc, out, err = run(*on, "motion", "push", "wave.yaml", "5")
-    check(rc == 2 and "step 1 (wave.yaml:" in err and "beyond its upper limit 100" in err and "nothing was written" in err,
+    rc, out, err = run(*on, "motion", "push", "beyond.yaml", "5")
+    check(rc == 2 and "step 1 (beyond.yaml:" in err and "beyond its upper limit 100" in err and "nothing was written" in err,
           f"push of a pose beyond a limit: exit 2 ({rc}: {err.strip()!r})")
     check(rom(on, 0x2B80, 4) == b"\xff" * 4 and not glob.glob("motion-5-*.bin"), "nothing written, no backup made")
 
@@ -132,14 +140,20 @@ with serve("--rom", rom_file, "--period", "15") as dev:
 
     # A running motion is not written over; a slot it neither runs, calls nor returns into is
     # (motion_safety_test.py has the rest of these rules).
-    run(*on, "motion", "play", "2")
-    before2 = rom(on, 0x1380, 16)
-    rc, out, err = run(*on, "motion", "push", "knee.yaml", "2")
-    check(rc == 1 and "motion 2 is running" in err and rom(on, 0x1380, 16) == before2, f"push over motion 2 while it runs: exit 1 ({rc}: {err.strip()!r})")
+    # (A motion that never ends, so that it still runs however slow the machine.)
+    write("loop12.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - label: top\n  - pose: {head_yaw: 10}\n"
+          "    time_ms: 300\n  - pose: {head_yaw: -10}\n    time_ms: 300\n  - goto: top\n")
+    run(*on, "motion", "push", "loop12.yaml", "12", "--backup", "twelve.bin")
+    run(*on, "motion", "play", "12")
+    before12 = rom(on, 0x6380, 16)
+    rc, out, err = run(*on, "motion", "push", "knee.yaml", "12")
+    check(rc == 1 and "motion 12 is running" in err and rom(on, 0x6380, 16) == before12, f"push over motion 12 while it runs: exit 1 ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "push", "knee.yaml", "7", "--backup", "seven.bin")
-    check(rc == 0 and rom(on, 0x3B80, 1) == b"\x08", f"push into motion 7 while motion 2 runs: written ({rc}: {err.strip()!r})")
-    run(*on, "motion", "wait", "--timeout", "5")
+    check(rc == 0 and rom(on, 0x3B80, 1) == b"\x08", f"push into motion 7 while motion 12 runs: written ({rc}: {err.strip()!r})")
+    run(*on, "motion", "stop")
+    run(*on, "motion", "play", "1", "--wait", "--timeout", "10")  # the program afresh
     run(*on, "motion", "push", "seven.bin", "7")
+    run(*on, "motion", "push", "twelve.bin", "12")
     run(*on, "motion", "wait", "--timeout", "5")
 
     # Erase, with a button on the slot; then the backup put back.
@@ -371,7 +385,22 @@ check(rc == 2 and "exists" in err, f"record does not replace a file ({rc}: {err.
 # Boards that are not ours.
 board = StandIn()  # acknowledges ROM writes and keeps nothing
 rc, out, err = run("--device", board.path, "motion", "push", "knee10.yaml", "1", "--layout", "2.2", "--backup", "x.bin")
-check(rc == 1 and "ROM 0x000B80 reads back 0xFF, 0x08 was written" in err, f"a board that does not keep ROM writes: exit 1 ({rc}: {err.strip()!r})")
+check(rc == 1 and "ROM 0x000B80 reads back 0xFF, 0x08 was written" in err and "rcb4 motion push x.bin 1 puts them back" in err,
+      f"a board that does not keep ROM writes: exit 1, the backup and the command that puts it back named ({rc}: {err.strip()!r})")
+# A board that dies at every point of a push: once the backup exists, the failure (in the write or
+# the read-back) names it and the command that puts the slot back.
+seen = set()
+for k in range(22, 29):  # around the write (the exchanges before it: layout, config, backup reads, state)
+    rc, out, err = run("--device", StandIn(mode="die", die_after=k).path, "--timeout", "50", "motion", "push",
+                       "knee10.yaml", "1", "--layout", "2.2", "--backup", f"die{k}.bin")
+    if os.path.exists(f"die{k}.bin"):
+        where = ("write" if "writing ROM" in err else "read-back" if "reading back ROM" in err
+                 else "compare" if "reads back 0xFF" in err else "?")
+        seen.add(where)
+        check(rc == (1 if where == "compare" else 4) and where != "?"
+              and f"rcb4 motion push die{k}.bin 1 puts them back" in err,
+              f"dies after {k} frames, after the backup ({where}): the way back named ({rc}: {err.strip()[-200:]!r})")
+check({"write", "read-back"} <= seen, f"the board died in the write and in the read-back at least once each ({seen})")
 rc, out, err = run("--device", StandIn(mode="die", die_after=200).path, "rom", "backup", "die.bin")
 check(rc == 4 and "reading ROM stopped at 0x" in err and not os.path.exists("die.bin"), f"a board that dies mid-backup: exit 4, no file ({rc}: {err.strip()!r})")
 rc, out, err = run("--device", StandIn(silent=True).path, "motion", "pull", "1", "s.yaml", "--layout", "2.2")

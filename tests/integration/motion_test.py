@@ -38,8 +38,13 @@ assert motion[51] == loop & 0xFF and motion[52] == loop >> 8  # the JUMP at +49 
 with serve() as dev:
     on = ["--device", dev]
     rc, out, err = run(*on, "motion", "show", "2")
-    check(rc == 0 and "motion 2 (wave) at 0x001380" in out and "right_shoulder_roll +101.2 (beyond its upper limit 100)" in out
+    check(rc == 0 and "motion 2 (wave) at 0x001380" in out and "right_shoulder_roll +94.5" in out and "beyond" not in out
           and "6 steps, assembled back to the same bytes" in out, f"motion show 2: the demo wave, poses in joints ({rc}, {err.strip()!r})")
+    # A pose beyond a limit is shown, not hidden (CONST ICS 5 = 10500, +101.25 deg, then RETURN, at motion 9).
+    run(*on, "write", "rom", "0x4B80", "0B 10 20 00 00 00 00 14 04 29 7C 03 0D 10")
+    rc, out, err = run(*on, "motion", "show", "9")
+    check(rc == 0 and "right_shoulder_roll +101.2 (beyond its upper limit 100)" in out,
+          f"motion show of a pose beyond a limit says so ({rc}, {out.strip()[-200:]!r})")
     rc, out, err = run(*on, "motion", "show", "5")
     check(rc == 0 and "empty (erased ROM)" in out, f"motion show of an erased slot says so ({out.strip()!r})")
     rc, out, err = run(*on, "write", "rom", hex(base), motion.hex())

@@ -194,7 +194,7 @@ TEST_CASE("ops: play a motion, follow its state, stop one", "[ops][motion]") {
   CHECK_FALSE(config_word::decode(stop.value()).rom_program);
   w.wait(2s);
   CHECK(w.read_word(0x0090 + 60 + 4) == 9500);
-  CHECK(w.read_word(0x0090 + 100 + 4) == 10500);
+  CHECK(w.read_word(0x0090 + 100 + 4) == 10300);
   ops::play_motion nope(121);
   CHECK(run(w, nope).empty());
   CHECK(nope.error() == errc::motion_out_of_range);

@@ -25,14 +25,7 @@ void emit(const json& j) {
   std::fflush(stdout);
 }
 
-std::string file_stamp() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::localtime_r(&t, &tm);
-  char b[32];
-  std::strftime(b, sizeof b, "%Y%m%d-%H%M%S", &tm);
-  return b;
-}
+std::string file_stamp() { return rcb4::robot::services::file_stamp(); }
 
 std::string plural(std::size_t n, std::string_view word) { return fmt::format("{} {}{}", n, word, n == 1 ? "" : "s"); }
 
@@ -298,8 +291,7 @@ rcb4::reply session_link::exchange(const rcb4::command& c) {
   rcb4::transport::error_code ec;
   last_.emplace(s_.c().exchange(c, ec));
   if (ec) {  // the services take std::system_error (Boost 1.81 carries the category across)
-    const std::error_code code(ec);
-    throw std::system_error(code, std::string(plain_message(rcb4::transport::system_error(ec).what())));
+    throw std::system_error(std::error_code(ec));
   }
   return last_->view();
 }

@@ -187,7 +187,9 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
       if (const auto* c = std::get_if<rcb4::const_servo>(&*in.cmd))
         for (const auto& e : c->targets()) {
           const auto* j = robot.on(e.ics);
-          const auto d = j ? rcb4::robot::to_degrees(*j, e.value.value()) : std::nullopt;
+          // Set in two steps: GCC 12 at -O3 took `j ? to_degrees(...) : nullopt` for uninitialised.
+          std::optional<double> d;
+          if (j) d = rcb4::robot::to_degrees(*j, e.value.value());
           const std::string name = j ? j->name : fmt::format("ICS {}", e.ics.value());
           joints[name] = d ? json(std::round(*d * 100) / 100) : json(nullptr);
           pose_text +=
@@ -364,7 +366,8 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     bar.finish();
     if (ec) throw rcb4::transport::system_error(ec);
     json arr = json::array();
-    if (!ctx.g.json) fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {}\n", "slot", "name", "address", "bytes", "frames");
+    // "commands": the frames of the protocol walked to the first RETURN, not interpolation frames.
+    if (!ctx.g.json) fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {}\n", "slot", "name", "address", "bytes", "commands");
     for (const auto& v : op.value()) {
       const auto name = m.motion(v.number);
       const std::string note = !v.readable ? "not a frame: another --layout?" : v.ends ? "" : "no RETURN found";
@@ -373,7 +376,8 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                        {"name", name.empty() ? json(nullptr) : json(std::string(name))},
                        {"address", v.address},
                        {"size", v.size},
-                       {"frames", v.frames},
+                       {"frames", v.frames},  // kept for scripts: the same count as "commands"
+                       {"commands", v.frames},
                        {"ends", v.ends},
                        {"readable", v.readable}});
       else

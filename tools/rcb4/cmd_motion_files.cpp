@@ -69,7 +69,6 @@ int pull(session& s, const pull_options& o, const globals& g) {
     throw usage_error(e.what());
   }
   const auto& d = r.document;
-  const auto& where = mo::slot_of(layout, n).value();
   const auto poses = r.poses;
   const auto ms = r.pose_ms;
   const auto period = r.period;
@@ -78,7 +77,7 @@ int pull(session& s, const pull_options& o, const globals& g) {
     emit(json{{"pulled", n},
               {"file", o.file},
               {"layout", layout.name},
-              {"address", where.address.value()},
+              {"address", r.address},
               {"bytes", r.bytes},
               {"steps", d.steps.size()},
               {"poses", poses},
@@ -87,7 +86,7 @@ int pull(session& s, const pull_options& o, const globals& g) {
               {"problem", beyond.empty() ? json(nullptr) : json(beyond)}});
   } else {
     fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({:.2f} s of moves at {} ms frames) -> {}\n", n,
-               where.address.value(), layout.name, r.bytes, d.steps.size(), plural(poses, "pose"),
+               r.address, layout.name, r.bytes, d.steps.size(), plural(poses, "pose"),
                static_cast<double>(ms) / 1000, rcb4::milliseconds(period), o.file);
     if (!beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", beyond);
   }

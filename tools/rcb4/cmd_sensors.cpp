@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <thread>
@@ -24,6 +25,12 @@ std::vector<std::string> button_names(std::uint16_t b) {
 }
 
 std::string buttons_text(std::uint16_t b) { return rcb4::motion::buttons_text(b); }
+
+/** A joint's measured angle for JSON, to a hundredth; null when its servo never answered. */
+json degrees_of(const rcb4::robot::joint_reading& r) {
+  const auto d = r.degrees();
+  return d ? json(std::round(*d * 100) / 100) : json(nullptr);
+}
 
 /** One reading of everything a KHR carries on its inputs. */
 struct reading {
@@ -63,15 +70,36 @@ int sensors(session& s, const globals& g) {
   return exit_ok;
 }
 
-int monitor(session& s, long long hz, long long count, const globals& g) {
+/**
+ * The joints --joints names (none: every joint of the profile the board has a servo block for),
+ * located once; a joint named outright that the board lacks is an error naming it.
+ */
+std::pair<rcb4::robot::joint_map, std::vector<const rcb4::robot::joint*>> monitored(
+    session& s, const globals& g, const std::vector<std::string>& words) {
+  const auto& m = robot_of(g);
+  if (!words.empty()) {
+    auto need = joints_of(m, words);
+    return {locate(s, m, need), std::move(need)};
+  }
+  auto map = s.run(rcb4::robot::locate_joints(m));
+  std::vector<const rcb4::robot::joint*> have;
+  for (const auto* j : joints_of(m, {}))
+    if (map.block_of(*j)) have.push_back(j);
+  return {std::move(map), std::move(have)};
+}
+
+int monitor(session& s, long long hz, long long count, const std::vector<std::string>& words, const globals& g) {
   const signal_catcher catcher;  // Ctrl-C ends the monitor after the sample under way
+  const auto [map, shown] = monitored(s, g, words);
   const bool tty = ::isatty(STDOUT_FILENO) && !g.json;
   const auto period = std::chrono::microseconds(1000000 / hz);
   const auto start = std::chrono::steady_clock::now();
   auto next = start;
   bool warned = false;
   for (long long n = 0; !signal_catcher::caught() && (count == 0 || n < count); ++n) {
+    // Every allocated servo (JSON "positions" by ICS number), and the joints by name.
     const auto states = s.run(rcb4::ops::read_servo_states(rcb4::ops::link_cost::at(s.baud(), 1ms)));
+    const auto joints = cli::read_all(s, map, rcb4::robot::fields::positions);
     const auto r = read_all(s);
     const auto now = std::chrono::steady_clock::now();
     const double elapsed = std::chrono::duration<double>(now - start).count();
@@ -87,6 +115,10 @@ int monitor(session& s, long long hz, long long count, const globals& g) {
       json pos = json::object();
       for (const auto& st : states) pos[std::to_string(st.ics.value())] = st.position;
       j["positions"] = pos;
+      json by_name = json::object();
+      for (const auto& jr : joints)
+        if (std::find(shown.begin(), shown.end(), jr.j) != shown.end()) by_name[jr.j->name] = degrees_of(jr);
+      j["joints"] = by_name;
       emit(j);
     } else {
       if (tty) fmt::print("\x1b[H\x1b[2J");
@@ -97,9 +129,17 @@ int monitor(session& s, long long hz, long long count, const globals& g) {
       fmt::print("AD1..10");
       for (std::size_t k = 1; k < r.analog.values.size(); ++k) fmt::print(" {:4}", r.analog.values[k]);
       fmt::print("\n");
-      for (std::size_t i = 0; i < states.size(); ++i)
-        fmt::print("ICS {:>2} {:<14}{}", states[i].ics.value(), position_text(states[i].position, "silent", true),
-                   i % 4 == 3 || i + 1 == states.size() ? "\n" : "  ");
+      std::size_t i = 0;
+      for (const auto& jr : joints) {
+        if (std::find(shown.begin(), shown.end(), jr.j) == shown.end()) continue;
+        const auto d = jr.degrees();
+        fmt::print("{:<22} {:>7}{}", jr.j->name,
+                   d ? fmt::format("{:+.1f}", *d) : std::string(jr.answered() ? "?" : "silent"),
+                   ++i % 3 == 0 ? "\n" : "   ");
+      }
+      if (i % 3 != 0) fmt::print("\n");
+      if (shown.empty())
+        fmt::print("no joint of {} has a servo on this board (rcb4 scan shows its slots)\n", robot_of(g).name());
       std::fflush(stdout);
     }
     next += period;
@@ -135,7 +175,11 @@ void add_sensor_commands(CLI::App& app, context& ctx) {
   monitor_cmd->add_option("--hz", *hz, "samples per second (default 5)")->check(int_range(1, 1000));
   monitor_cmd->add_option("--count", *count, "stop after N samples (default: until Ctrl-C)")
       ->check(int_range(1, 100000000));
-  on_device(monitor_cmd, ctx, [&ctx, hz, count](session& s) { return monitor(s, *hz, *count, ctx.g); });
+  auto words = std::make_shared<std::vector<std::string>>();
+  monitor_cmd->add_option("--joints", *words,
+                          "joints, groups (left_arm, legs, ...) or all of --robot's profile (default: every joint the "
+                          "board has a servo for)");
+  on_device(monitor_cmd, ctx, [&ctx, hz, count, words](session& s) { return monitor(s, *hz, *count, *words, ctx.g); });
 }
 
 }  // namespace cli

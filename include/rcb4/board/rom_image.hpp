@@ -65,7 +65,7 @@ inline constexpr std::string_view demo_motion_names[] = {"home", "wave", "bow"};
 
 /**
  * The default 256 KiB ROM image: boot, main loop, config word, and three demo motions:
- * 1 "home" (every servo of khr3hv_servos to 7500), 2 "wave" (right arm), 3 "bow" (hips and knees).
+ * 1 "home" (every servo of khr3hv_servos to 7500), 2 "wave" (right arm), 3 "bow" (hips' pitch and knees).
  */
 inline std::vector<std::uint8_t> default_rom() {
   std::vector<std::uint8_t> rom(rom_size, 0xFF);  // erased EEPROM reads 0xFF
@@ -90,16 +90,19 @@ inline std::vector<std::uint8_t> default_rom() {
   put_motion(rom, l, 1, {{30, {{0, 7500},  {1, 7500},  {2, 7500},  {3, 7500},  {4, 7500},  {5, 7500},  {6, 7500},
                                {7, 7500},  {8, 7500},  {9, 7500},  {12, 7500}, {13, 7500}, {14, 7500}, {15, 7500},
                                {16, 7500}, {17, 7500}, {18, 7500}, {19, 7500}, {20, 7500}, {21, 7500}}}});
+  // Wave: the right shoulder's pitch (ICS 3) to +67.5°, its roll (ICS 5) between +94.5° and
+  // +56.25°: inside the KHR-3HV profile's limits, so a pulled copy pushes back as it is.
   put_motion(rom, l, 2,
-             {{20, {{3, 9500}, {5, 10500}}},
+             {{20, {{3, 9500}, {5, 10300}}},
               {10, {{5, 9000}}},
-              {10, {{5, 10500}}},
+              {10, {{5, 10300}}},
               {10, {{5, 9000}}},
               {20, {{3, 7500}, {5, 7500}}}});
+  // Bow: both hips' pitch (ICS 14, 15) forward by 33.75°, the knees (16, 17) bent 16.9° to balance.
   put_motion(rom, l, 3,
-             {{25, {{12, 6500}, {13, 8500}, {16, 8500}, {17, 6500}}},
-              {15, {{12, 6500}, {13, 8500}}},
-              {25, {{12, 7500}, {13, 7500}, {16, 7500}, {17, 7500}}}});
+             {{25, {{14, 8500}, {15, 6500}, {16, 8000}, {17, 7000}}},
+              {15, {{14, 8500}, {15, 6500}}},
+              {25, {{14, 7500}, {15, 7500}, {16, 7500}, {17, 7500}}}});
   return rom;
 }
 

@@ -326,7 +326,7 @@ class on_servos {
   }
   void on_reply(const reply& r) {
     if (!have_mask_) {
-      const auto slots = allocated_slots(r);
+      const auto slots = allocated_slots_fixed(r);  // no heap (GCC 12 -O2 misread the vector's free here)
       if ((error_ = slots.error()) != errc{}) return;
       servo_mask all;
       for (const auto& s : *slots) all.insert(s.ics);

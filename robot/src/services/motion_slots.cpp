@@ -183,14 +183,19 @@ void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> 
 
 }  // namespace
 
+std::string file_stamp() {
+  char stamp[32];
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  ::localtime_r(&t, &tm);
+  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+  return stamp;
+}
+
 std::string save_backup_file(unsigned motion, std::span<const std::uint8_t> old, const std::string& path_) {
   std::string path = path_;
   if (path.empty()) {
-    char stamp[32];
-    const std::time_t t = std::time(nullptr);
-    std::tm tm{};
-    ::localtime_r(&t, &tm);
-    std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+    const auto stamp = file_stamp();
     path = fmt::format("motion-{}-{}.bin", motion, stamp);
     for (int k = 2; std::filesystem::exists(path); ++k) path = fmt::format("motion-{}-{}-{}.bin", motion, stamp, k);
   } else if (std::filesystem::exists(path)) {

@@ -50,11 +50,7 @@ void save_rom_image(const std::string& path, std::span<const std::uint8_t> image
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
   out.flush();
-  char stamp[32];
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  ::localtime_r(&t, &tm);
-  std::strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &tm);
+  const auto stamp = file_stamp();
   std::ofstream sum(path + ".crc32", std::ios::trunc);
   sum << fmt::format("{:08x}  {}  {} bytes  {}  {}\n", crc32(image), std::filesystem::path(path).filename().string(),
                      image.size(), stamp, version);

@@ -59,6 +59,9 @@ class link {
   }
 };
 
+/** The local time for the names of files a workflow saves: "20261124-230605". */
+std::string file_stamp();
+
 /** Runs @p op (kept by the caller) to its end on @p l; its failure through link::failed. */
 template <ops::Operation Op>
 Op& drive(link& l, Op& op) {
