@@ -127,7 +127,7 @@ sv::restore_report board::rom_restore(std::span<const std::uint8_t> image, const
 void board::check_playable(unsigned n, const char* what) {
   const auto& layout = this->layout();
   service(what, [&](sv::link& l) {
-    sv::require_playable(l, layout, n, "motion " + std::to_string(n));
+    sv::require_playable(l, layout, n, "");  // the service error is prefixed with the call's name
     return 0;
   });
 }

@@ -148,7 +148,7 @@ with serve("--period", "15") as dev:
     check(len(listed) == 1 and not listed[0].get("ends", True), f"motion list marks motion 80 broken ({listed})")
     rc, out, err = run(*on, "motion", "play", "80")
     st = status(on)
-    check(rc == 1 and f"motion play 80: motion 80 (0x{slot(80):06X}) is broken" in err and "checksum" in err
+    check(rc == 1 and f"rcb4 motion play: motion 80 (0x{slot(80):06X}) is broken" in err and "checksum" in err
           and not st.get("running"), f"motion play of a broken slot refused, nothing started ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "buttons", "set", "s2+up", "80")
     check(rc == 1 and "is broken" in err, f"a button is not set to play a broken slot ({rc}: {err.strip()!r})")

@@ -129,7 +129,7 @@ int play(session& s, unsigned n, bool release, bool and_wait, const motion_optio
   {
     // An empty or broken slot (as motion list marks it) would stop the board's program: refused first.
     session_link link(s, g.json);
-    rcb4::robot::services::require_playable(link, layout, n, fmt::format("motion play {}", n));
+    rcb4::robot::services::require_playable(link, layout, n, "");  // the tool prefixes its command
   }
   s.run(rcb4::ops::play_motion(n, layout, release ? rcb4::ops::servo_power::release : rcb4::ops::servo_power::keep));
   if (!and_wait) {

@@ -292,8 +292,8 @@ void require_writable(link& l, const rom_layout& layout, unsigned n, std::span<c
   const std::string state = st.running ? "is running" : "is stopped part way";
   const std::string pc_name = name_of(layout, st.program_counter);
   const std::string hint = st.running ? "rcb4 motion wait, or rcb4 motion stop and then rcb4 motion play N (any "
-                                        "motion), which starts the program afresh; then write"
-                                      : "rcb4 motion play N (any motion) starts the program afresh; then write";
+                                        "motion), which starts the program afresh; then try again"
+                                      : "rcb4 motion play N (any motion) starts the program afresh; then try again";
   if (st.motion && *st.motion == n)
     throw refused(
         refusal_kind::board,
@@ -327,12 +327,12 @@ void require_playable(link& l, const rom_layout& layout, unsigned n, std::string
   rom_code rom(l, layout, nullptr);
   const auto& c = rom.at(where.address.value());
   if (c.problems.empty()) return;
-  throw refused(
-      refusal_kind::board,
-      fmt::format("{}: motion {} (0x{:06X}) {}: a play would stop the board's program there", what, n,
-                  where.address.value(), c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")"),
-      c.code.empty() ? "rcb4 motion list shows the used slots"
-                     : fmt::format("rcb4 motion show {} lists its code; push it again", n));
+  throw refused(refusal_kind::board,
+                fmt::format("{}motion {} (0x{:06X}) {}: a play would stop the board's program there",
+                            what.empty() ? std::string() : std::string(what) + ": ", n, where.address.value(),
+                            c.code.empty() ? "holds no motion" : "is broken (" + first_problem(c) + ")"),
+                c.code.empty() ? "rcb4 motion list shows the used slots"
+                               : fmt::format("rcb4 motion show {} lists its code; push it again", n));
 }
 
 namespace {
@@ -380,7 +380,8 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
     unsigned frames = 0;
     for (const auto& st : cm.program.steps)
       if (const auto* p = std::get_if<mo::pose>(&st)) ++poses, frames += p->time.value();
-    r.summary = fmt::format("{} steps, {} pose{} ({:.2f} s of moves)", cm.program.steps.size(), poses,
+    const auto steps = cm.program.steps.size();
+    r.summary = fmt::format("{} step{}, {} pose{} ({:.2f} s of moves)", steps, steps == 1 ? "" : "s", poses,
                             poses == 1 ? "" : "s", frames * rcb4::milliseconds(cm.period) / 1000.0);
   }
   if (dry_run) return r;

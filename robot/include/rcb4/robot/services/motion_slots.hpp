@@ -104,7 +104,7 @@ pull_report pull_motion(link& l, const model& robot, const rom_layout& layout, u
 /**
  * Refuses a play of motion @p n (by the host, or by a button) when its slot is empty or broken
  * (a frame that fails its checksum, no RETURN reached): the board would stop its program there.
- * @p what names the play ("motion play 3", "UP plays motion 3").
+ * @p what names the play in the message ("UP plays it"; empty: the message starts with the motion).
  */
 void require_playable(link& l, const rom_layout& layout, unsigned n, std::string_view what);
 
