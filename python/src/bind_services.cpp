@@ -157,11 +157,11 @@ void bind_services(py::class_<board>& cls) {
               const auto p = path_of(what);
               src.name = p;
               if (std::filesystem::path(p).extension() == ".bin") {
-                std::ifstream in(p, std::ios::binary);
-                if (!in) throw board_error(fault::usage, "path: " + p + " cannot be read");
-                src.bin.resize(8193);
-                in.read(reinterpret_cast<char*>(src.bin.data()), static_cast<std::streamsize>(src.bin.size()));
-                src.bin.resize(static_cast<std::size_t>(in.gcount()));
+                try {
+                  src.bin = sv::read_backup_file(p);
+                } catch (const sv::refused& e) {
+                  throw board_error(fault::usage, e.what());
+                }
               } else {
                 try {
                   src.document = rcb4::robot::load_motion(p, b.robot());

@@ -68,27 +68,22 @@ int pull(session& s, const pull_options& o, const globals& g) {
   } catch (const ro::profile_error& e) {
     throw usage_error(e.what());
   }
-  const auto& d = r.document;
-  const auto poses = r.poses;
-  const auto ms = r.pose_ms;
-  const auto period = r.period;
-  const auto& beyond = r.beyond;
   if (g.json) {
     emit(json{{"pulled", n},
               {"file", o.file},
               {"layout", layout.name},
               {"address", r.address},
               {"bytes", r.bytes},
-              {"steps", d.steps.size()},
-              {"poses", poses},
-              {"pose_ms", ms},
-              {"period_ms", rcb4::milliseconds(period)},
-              {"problem", beyond.empty() ? json(nullptr) : json(beyond)}});
+              {"steps", r.document.steps.size()},
+              {"poses", r.poses},
+              {"pose_ms", r.pose_ms},
+              {"period_ms", rcb4::milliseconds(r.period)},
+              {"problem", r.beyond.empty() ? json(nullptr) : json(r.beyond)}});
   } else {
     fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({:.2f} s of moves at {} ms frames) -> {}\n", n,
-               r.address, layout.name, r.bytes, d.steps.size(), plural(poses, "pose"),
-               static_cast<double>(ms) / 1000, rcb4::milliseconds(period), o.file);
-    if (!beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", beyond);
+               r.address, layout.name, r.bytes, r.document.steps.size(), plural(r.poses, "pose"),
+               static_cast<double>(r.pose_ms) / 1000, rcb4::milliseconds(r.period), o.file);
+    if (!r.beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", r.beyond);
   }
   return exit_ok;
 }
@@ -106,12 +101,7 @@ sv::push_source source_of(const push_options& o, const globals& g) {
   src.name = o.file;
   src.rescale = o.rescale;
   if (std::filesystem::path(o.file).extension() == ".bin") {
-    std::ifstream in(o.file, std::ios::binary);
-    if (!in) throw usage_error(fmt::format("FILE: {} cannot be read ({})", o.file, std::strerror(errno)));
-    // A slot holds at most a few KiB: read one byte more than the largest, never a whole big file.
-    src.bin.resize(8193);
-    in.read(reinterpret_cast<char*>(src.bin.data()), static_cast<std::streamsize>(src.bin.size()));
-    src.bin.resize(static_cast<std::size_t>(in.gcount()));
+    src.bin = sv::read_backup_file(o.file);
     return src;
   }
   try {

@@ -212,6 +212,15 @@ std::string save_backup_file(unsigned motion, std::span<const std::uint8_t> old,
   return path;
 }
 
+std::vector<std::uint8_t> read_backup_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw refused(refusal_kind::usage, fmt::format("FILE: {} cannot be read ({})", path, std::strerror(errno)));
+  std::vector<std::uint8_t> b(8193);  // a slot holds at most 2 KiB: more than 8 KiB is no backup of one
+  in.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  b.resize(static_cast<std::size_t>(in.gcount()));
+  return b;
+}
+
 mo::slot slot_for(const rom_layout& layout, long long n) {
   const auto where = n >= 1 ? mo::slot_of(layout, static_cast<unsigned>(n)) : std::nullopt;
   if (!where || n > layout.motion_count)

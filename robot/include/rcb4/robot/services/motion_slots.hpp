@@ -34,6 +34,13 @@ using backup_sink = std::function<std::string(unsigned motion, std::span<const s
 /** Writes @p old to @p path, or to motion-N-DATE.bin in the working directory when empty; a refusal names why not. */
 std::string save_backup_file(unsigned motion, std::span<const std::uint8_t> old, const std::string& path = {});
 
+/**
+ * The bytes of a backup file (a .bin a push or erase saved), read at most one byte past any slot's
+ * size, so a wrong or huge file is never read whole; a usage refusal naming it when unreadable.
+ * push_motion refuses more bytes than the slot takes.
+ */
+std::vector<std::uint8_t> read_backup_file(const std::string& path);
+
 /** Motion @p n's slot in @p layout; a usage refusal outside 1..motion_count. */
 motion::slot slot_for(const rom_layout& layout, long long n);
 
