@@ -17,6 +17,8 @@ packages=(
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
+  libjs-three                          # three.js r111 (with OrbitControls): rcb4 ui draws the robot in 3D (embedded at build time)
+  liburdfdom-tools                     # check_urdf: the suite checks that `rcb4 urdf` parses
   pybind11-dev python3-dev python3-pytest python3-numpy python3-serial  # pyrcb4, its tests, its benchmark
   python3-rospy python3-rosmaster python3-rostopic python3-sensor-msgs python3-trajectory-msgs \
   python3-std-srvs python3-std-msgs python3-diagnostic-msgs python3-rosservice python3-rosnode python3-roslaunch  # rcb4_ros: ROS 1's Python side only (its C++ packages would remove libboost1.81-dev)

@@ -23,5 +23,40 @@ from ._core import (  # noqa: F401
     save_pose,
 )
 
-__all__ = ["Board", "ControlLoop", "load_pose", "save_pose", "move_refusal", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
+
+
+class ArgumentError(UsageError, TypeError):
+    """An argument of the wrong type (a UsageError, and a TypeError as Python raises for one)."""
+
+
+def _one_line(name, method):
+    """method, with pybind11's many-line "incompatible function arguments" TypeError as one line."""
+    import functools
+
+    @functools.wraps(method)
+    def call(*args, **kwargs):
+        try:
+            return method(*args, **kwargs)
+        except TypeError as e:
+            text = str(e)
+            if "incompatible function arguments" not in text and "incompatible constructor arguments" not in text:
+                raise
+            # "1. (self: pyrcb4._core.Board, n: int, ...) -> object" names what it takes.
+            takes = ""
+            for line in text.splitlines():
+                if line.strip().startswith("1. ("):
+                    takes = line.strip()[3:].split(") -> ")[0] + ")"
+                    takes = takes.replace("self: pyrcb4._core.Board, ", "").replace("self: pyrcb4._core.Board", "")
+                    takes = takes.replace("*args", "*names")
+            given = ", ".join([repr(a) for a in args[1:]] + [f"{k}={v!r}" for k, v in kwargs.items()])
+            raise ArgumentError(f"{name}{takes or '(...)'}: called with ({given})") from None
+    return call
+
+
+for _name, _member in list(vars(Board).items()):
+    if _name == "__init__" or (not _name.startswith("_") and callable(_member)):
+        setattr(Board, _name, _one_line("Board" if _name == "__init__" else _name, _member))
+del _name, _member
+
+__all__ = ["Board", "ArgumentError", "ControlLoop", "load_pose", "save_pose", "move_refusal", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
            "__version__"]

@@ -83,24 +83,36 @@ void bind_robot(py::module_& m, py::class_<board>& cls) {
           "seconds (default: the file's time_ms, else 1 s). Limits are checked before anything is sent.")
       .def(
           "trims",
-          [](board& b) {
-            const std::vector<rcb4::robot::joint_reading> rs = unlocked([&] { return b.states(); });
+          [](board& b, bool rom) {
+            const auto ts = unlocked([&] { return b.trims(); });
             py::dict d;
-            for (const auto& r : rs)
-              if (r.allocated) d[py::str(r.j->name)] = std::round(rcb4::robot::trim_degrees(*r.j, r.trim) * 100) / 100;
+            for (const auto& t : ts) {
+              if (!t.allocated) continue;
+              const auto deg = rom ? t.rom_degrees() : std::optional<double>(t.degrees());
+              d[py::str(t.j->name)] =
+                  deg ? py::object(py::float_(std::round(*deg * 100) / 100)) : py::object(py::none());
+            }
             return d;
           },
-          "Every joint's trim in degrees (joints without a servo left out).")
+          "rom"_a = false,
+          "Every joint's trim in degrees (joints without a servo left out): what the board adds now, or with "
+          "rom=True what power-on loads (None where the ROM has no copy).")
       .def(
           "set_trims",
           [](board& b, const py::dict& trims, bool persistent) {
             std::vector<std::pair<std::string, double>> ts;
-            for (const auto& [k, v] : trims) ts.emplace_back(k.cast<std::string>(), v.cast<double>());
-            py::gil_scoped_release release;
-            b.set_trims(ts, persistent);
+            for (const auto& [k, v] : trims) {
+              if (!py::isinstance<py::str>(k)) throw board_error(fault::usage, "trims: {joint name: degrees}");
+              ts.emplace_back(k.cast<std::string>(), number_of(v, "trims"));
+            }
+            const auto r = unlocked([&] { return b.set_trims(ts, persistent); });
+            py::dict out;
+            for (const auto& t : r.written) out[py::str(t.j->name)] = t.counts;
+            return out;
           },
           "trims"_a, "persistent"_a = false,
-          "Sets trims {joint: degrees} (within ±30; LimitError beyond); persistent=True also writes them to ROM.")
+          "Sets trims {joint: degrees} (within ±30; LimitError beyond) and reads them back; persistent=True also "
+          "writes them to ROM. Returns {joint: counts}.")
       .def(
           "servos",
           [](board& b) {

@@ -68,6 +68,51 @@ py::dict table_data(const sv::table_report& r, const rcb4::rom_layout& layout) {
                   "ram_followed_rom"_a = r.ram_followed_rom);
 }
 
+/** What push_motion and play_motion_file take: a motion file, a .bin backup, or steps as data. */
+sv::push_source source_of(board& b, const py::object& what) {
+  sv::push_source src;
+  if (py::isinstance<py::list>(what) || py::isinstance<py::dict>(what)) {
+    // Steps as data (a list, or the dict pull_motion gives): JSON is YAML, so the motion-file parser reads
+    // them.
+    py::dict doc;
+    if (py::isinstance<py::dict>(what)) {
+      for (const auto& kv : what.cast<py::dict>()) {
+        const auto key = kv.first.cast<std::string>();
+        if (key == "robot" || key == "name" || key == "period_ms" || key == "steps") doc[kv.first] = kv.second;
+      }
+    } else {
+      doc["steps"] = what;
+    }
+    if (!doc.contains("robot")) doc["robot"] = b.robot().name();
+    if (!doc.contains("period_ms"))  // times in ms of this board's period
+      doc["period_ms"] = rcb4::milliseconds(unlocked([&] { return b.period(); }));
+    const auto text = py::module_::import("json").attr("dumps")(doc).cast<std::string>();
+    try {
+      src.document = rcb4::robot::parse_motion(text, "steps", b.robot());
+    } catch (const rcb4::robot::profile_error& e) {
+      throw board_error(fault::usage, e.what());
+    }
+    src.name = "steps";
+  } else {
+    const auto p = path_of(what);
+    src.name = p;
+    if (std::filesystem::path(p).extension() == ".bin") {
+      try {
+        src.bin = sv::read_backup_file(p);
+      } catch (const sv::refused& e) {
+        throw board_error(fault::usage, e.what());
+      }
+    } else {
+      try {
+        src.document = rcb4::robot::load_motion(p, b.robot());
+      } catch (const rcb4::robot::profile_error& e) {
+        throw board_error(fault::usage, e.what());
+      }
+    }
+  }
+  return src;
+}
+
 }  // namespace
 
 void bind_services(py::class_<board>& cls) {
@@ -128,48 +173,8 @@ void bind_services(py::class_<board>& cls) {
           "push_motion",
           [](board& b, const py::object& what, long long n, const py::object& backup, bool rescale, bool dry_run) {
             const auto k = motion_number(n);
-            sv::push_source src;
+            sv::push_source src = source_of(b, what);
             src.rescale = rescale;
-            if (py::isinstance<py::list>(what) || py::isinstance<py::dict>(what)) {
-              // Steps as data (a list, or the dict pull_motion gives): JSON is YAML, so the motion-file parser reads
-              // them.
-              py::dict doc;
-              if (py::isinstance<py::dict>(what)) {
-                for (const auto& kv : what.cast<py::dict>()) {
-                  const auto key = kv.first.cast<std::string>();
-                  if (key == "robot" || key == "name" || key == "period_ms" || key == "steps")
-                    doc[kv.first] = kv.second;
-                }
-              } else {
-                doc["steps"] = what;
-              }
-              if (!doc.contains("robot")) doc["robot"] = b.robot().name();
-              if (!doc.contains("period_ms"))  // times in ms of this board's period
-                doc["period_ms"] = rcb4::milliseconds(unlocked([&] { return b.period(); }));
-              const auto text = py::module_::import("json").attr("dumps")(doc).cast<std::string>();
-              try {
-                src.document = rcb4::robot::parse_motion(text, "steps", b.robot());
-              } catch (const rcb4::robot::profile_error& e) {
-                throw board_error(fault::usage, e.what());
-              }
-              src.name = "steps";
-            } else {
-              const auto p = path_of(what);
-              src.name = p;
-              if (std::filesystem::path(p).extension() == ".bin") {
-                try {
-                  src.bin = sv::read_backup_file(p);
-                } catch (const sv::refused& e) {
-                  throw board_error(fault::usage, e.what());
-                }
-              } else {
-                try {
-                  src.document = rcb4::robot::load_motion(p, b.robot());
-                } catch (const rcb4::robot::profile_error& e) {
-                  throw board_error(fault::usage, e.what());
-                }
-              }
-            }
             const std::string to = backup.is_none() ? std::string() : path_of(backup);
             if (!to.empty() && std::filesystem::path(to).extension() != ".bin")
               throw board_error(fault::usage, "backup: " + to + " does not end in .bin (push_motion puts a .bin back)");
@@ -178,12 +183,90 @@ void bind_services(py::class_<board>& cls) {
                             "bytes"_a = r.bytes.size(), "hex"_a = fmt::format("{}", rcb4::hex_view{r.bytes}),
                             "unchanged"_a = r.unchanged, "dry_run"_a = r.dry_run,
                             "backup"_a = r.backup.empty() ? py::object(py::none()) : py::object(py::str(r.backup)),
-                            "summary"_a = r.summary, "notes"_a = r.notes);
+                            "summary"_a = r.summary, "notes"_a = r.notes,
+                            "name"_a = r.name.empty() ? py::object(py::none()) : py::object(py::str(r.name)));
           },
           "what"_a, "n"_a, "backup"_a = py::none(), "rescale"_a = false, "dry_run"_a = false,
           "Writes a motion file (.yaml), a backup (.bin), or steps (a list, or pull_motion's dict) into motion n: "
           "checked, the old bytes saved to backup (a new .bin; default motion-N-DATE.bin here), written, read back. "
           "Returns the report: address, bytes, backup, notes, ...")
+      .def(
+          "play_motion_file",
+          [](board& b, const py::object& what, bool rescale, double timeout) {
+            if (!py::isinstance<py::list>(what) && !py::isinstance<py::dict>(what) &&
+                std::filesystem::path(path_of(what)).extension() == ".bin")
+              throw board_error(fault::usage,
+                                "play_motion_file: " + path_of(what) + " is a slot's bytes: push it, then play");
+            const auto src = source_of(b, what);
+            if (!src.document)
+              throw board_error(fault::usage,
+                                "play_motion_file: " + src.name + " is a slot's bytes: push it, then play");
+            const auto r = unlocked([&] {
+              return b.play_file(*src.document, src.name, rescale, timeout, [] {
+                py::gil_scoped_acquire acquire;
+                return PyErr_CheckSignals() != 0;
+              });
+            });
+            if (r.interrupted && PyErr_Occurred()) throw py::error_already_set();  // Ctrl-C: KeyboardInterrupt
+            return py::dict("poses"_a = r.poses, "calls"_a = r.calls, "seconds"_a = std::round(r.seconds * 100) / 100,
+                            "interrupted"_a = r.interrupted, "notes"_a = r.notes);
+          },
+          "what"_a, "rescale"_a = false, "timeout"_a = 60.0,
+          "Plays a motion file (.yaml) or steps (a list, or pull_motion's dict) from the host, pose by pose at the "
+          "board's timing; checked first as a push is (nothing sent when refused). A ROM motion it calls may run "
+          "timeout seconds (then stopped: Timeout). Ctrl-C stops it (and a ROM motion it called). Nothing is written "
+          "to ROM. Returns poses, calls, seconds, notes.")
+      .def(
+          "record",
+          [](board& b, const py::object& path, const py::object& joints, double every, const py::object& seconds,
+             bool free, double threshold, bool force) {
+            std::string p;
+            if (!path.is_none()) {
+              p = path_of(path);
+              const auto ext = std::filesystem::path(p).extension();
+              if (ext != ".yaml" && ext != ".yml")
+                throw board_error(fault::usage, "path: " + p + " does not end in .yaml or .yml");
+              if (std::filesystem::exists(p) && !force)
+                throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
+            }
+            std::vector<std::string> words;
+            if (!joints.is_none()) {
+              if (py::isinstance<py::str>(joints)) throw board_error(fault::usage, "joints: a list of names");
+              for (const auto& j : joints) {
+                if (!py::isinstance<py::str>(j)) throw board_error(fault::usage, "joints: a list of names");
+                words.push_back(j.cast<std::string>());
+              }
+            }
+            const double s = seconds.is_none() ? 0.0 : number_of(seconds, "seconds");
+            const auto r = unlocked([&] {
+              return b.record(words, every, s, threshold, free, [] {
+                py::gil_scoped_acquire acquire;
+                return PyErr_CheckSignals() != 0;
+              });
+            });
+            PyErr_Clear();  // Ctrl-C ends a recording: what was recorded is the result
+            if (!p.empty()) {
+              try {
+                rcb4::robot::save_motion(p, r.document,
+                                         fmt::format("recorded by pyrcb4: {} samples over {:.1f} s", r.samples,
+                                                     std::chrono::duration<double>(r.span).count()));
+              } catch (const rcb4::robot::profile_error& e) {
+                throw board_error(fault::usage, e.what());
+              }
+            }
+            auto d = document_data(r.document);
+            d["samples"] = r.samples;
+            d["clamped"] = r.clamped;
+            d["held"] = r.held;
+            d["file"] = p.empty() ? py::object(py::none()) : py::object(py::str(p));
+            return d;
+          },
+          "path"_a = py::none(), "joints"_a = py::none(), "every"_a = 0.1, "seconds"_a = py::none(), "free"_a = false,
+          "threshold"_a = 2.0, "force"_a = false,
+          "Teach by demonstration: samples the joints (names or groups; None: all) every `every` seconds while you "
+          "move the robot by hand (free=True frees them first and holds them again at the end), for `seconds` (None: "
+          "until Ctrl-C), and keeps the poses that replay the movement. Returns the motion as pull_motion does; with "
+          "path also written there (.yaml). Refused while a motion runs or when a joint's servo does not answer.")
       .def(
           "erase_motion",
           [](board& b, long long n, const py::object& backup) {

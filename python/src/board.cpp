@@ -92,6 +92,7 @@ board::board(const std::string& device, std::uint32_t baud, const std::string& r
     auto socket = t::connect(io_->context(), path.substr(4), ec);
     if (ec) raise(ec, path);
     opt.baud = baud ? baud : 115200;  // the bridge's rate is unknown: the slowest gives safe deadlines
+    baud_known_ = baud != 0;
     client_ = std::make_unique<client>(adopt(io_->context(), socket.native_handle()), opt);
   } else {
     if (baud == 0) {
@@ -104,7 +105,10 @@ board::board(const std::string& device, std::uint32_t baud, const std::string& r
     if (ec) raise(ec, path);
     ::tcflush(port.native_handle(), TCIFLUSH);  // what a previous program left must not answer us
     opt.baud = baud;
-    client_ = std::make_unique<client>(adopt(io_->context(), port.native_handle()), opt);
+    auto own = adopt(io_->context(), port.native_handle());
+    line_fd_ = own.native_handle();
+    line_baud_ = baud;
+    client_ = std::make_unique<client>(std::move(own), opt);
   }
   client_->execute(rcb4::ping{rcb4::ping_form::short_}, ec);
   if (ec) {
@@ -116,8 +120,10 @@ board::board(const std::string& device, std::uint32_t baud, const std::string& r
 board::~board() { close(); }
 
 void board::close() {
+  closing_ = true;               // a long wait (a motion, a play, a recording) ends at its next look
   std::unique_lock life(life_);  // waits for calls under way: each ends by its deadline
   client_.reset();
+  line_fd_ = -1;
   t::board_server::shutdown(server_);
   board_io_.reset();
   io_.reset();
@@ -129,9 +135,39 @@ bool board::is_open() const {
   return client_ != nullptr;
 }
 
-std::uint32_t board::baud() const {
+std::optional<std::uint32_t> board::baud() const {
   std::shared_lock life(life_);
-  return client_ ? client_->options().baud : 0;
+  if (!client_ || !baud_known_) return std::nullopt;
+  return client_->options().baud;
+}
+
+void board::fail(const std::error_code& ec, const std::string& what) {
+  // Another program (stty, a terminal, pyserial opening the port) may have changed the line under
+  // us: a wrong rate or a cooked line answers nothing, and looks like an unplugged cable for ever.
+  // (A cooked line even reads as closed: its end-of-file character, ^D, may be a byte of a reply.)
+  const bool line_fault = ec == t::transport_errc::timeout || ec == t::transport_errc::no_board ||
+                          ec == t::transport_errc::truncated || ec == t::transport_errc::closed ||
+                          ec == t::transport_errc::echo || ec.category() == rcb4::codec_category();
+  if (line_fault && line_fd_ >= 0) {
+    t::detail::kernel_termios2 now{};
+    if (::ioctl(line_fd_, t::detail::tcgets2, &now) == 0) {
+      const bool rate = t::detail::rate_close(now.c_ospeed, line_baud_);
+      const bool raw = (now.c_lflag & (ICANON | ECHO | ISIG)) == 0 && (now.c_cflag & CSIZE) == CS8 &&
+                       (now.c_iflag & (IXON | ICRNL)) == 0;
+      if (!rate || !raw) {
+        std::uint32_t got = 0;
+        bool parity = false;
+        const auto again = t::detail::set_rcb4_line(line_fd_, line_baud_, got, parity);
+        const std::string changed = "another program changed " + where_ + "'s settings (" +
+                                    (rate ? std::string() : "rate " + std::to_string(now.c_ospeed) + " baud") +
+                                    (!rate && !raw ? ", " : "") + (raw ? "" : "no longer a raw 8-bit line") + ")";
+        throw board_error(fault::device, what + ": " + ec.message() + ": " + changed +
+                                             (again ? ", and they could not be set again: " + again.message()
+                                                    : "; they are set again: try the call again"));
+      }
+    }
+  }
+  raise(ec, what);
 }
 
 client& board::c(const char* what) {
@@ -150,7 +186,7 @@ void board::refuse_if_motion_runs(const char* what) {
   t::error_code ec;
   rcb4::ops::read_motion_state op;
   t::run(c(what), op, ec);
-  if (ec) raise(ec, what);
+  if (ec) fail(ec, what);
   // The one rule (rcb4/robot/services/moves.hpp).
   if (const auto why = rcb4::robot::services::move_refusal(op.value()))
     throw board_error(fault::refused, std::string(what) + ": " + *why + " (stop_motion() or wait_motion() first)");
@@ -161,7 +197,7 @@ auto board::run(Op op, const char* what) {
   std::shared_lock life(life_);
   t::error_code ec;
   t::run(c(what), op, ec);
-  if (ec) raise(ec, what);
+  if (ec) fail(ec, what);
   return op.value();
 }
 
@@ -170,7 +206,7 @@ double board::ping() {
   t::error_code ec;
   const auto start = std::chrono::steady_clock::now();
   c("ping").execute(rcb4::ping{rcb4::ping_form::short_}, ec);
-  if (ec) raise(ec, "ping");
+  if (ec) fail(ec, "ping");
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -248,7 +284,7 @@ double board::move(const std::vector<std::pair<std::string, double>>& targets, d
   return longest * rcb4::milliseconds(period) / 1000.0;
 }
 
-std::vector<std::string> board::power(bool free, const std::vector<std::string>& words) {
+std::vector<const rcb4::robot::joint*> board::joints_named(const std::vector<std::string>& words) const {
   std::vector<const rcb4::robot::joint*> js;
   for (const auto& w : words.empty() ? std::vector<std::string>{"all"} : words) {
     const auto sel = model_.select(w);
@@ -256,6 +292,11 @@ std::vector<std::string> board::power(bool free, const std::vector<std::string>&
     for (const auto* j : std::get<std::vector<const rcb4::robot::joint*>>(sel))
       if (std::find(js.begin(), js.end(), j) == js.end()) js.push_back(j);
   }
+  return js;
+}
+
+std::vector<std::string> board::power(bool free, const std::vector<std::string>& words) {
+  const auto js = joints_named(words);
   const auto& map = joints_located();
   rcb4::servo_mask mask;
   std::vector<std::string> done;
@@ -295,6 +336,27 @@ rcb4::output_period board::period() { return run(rcb4::ops::read_config{}, "read
 
 void board::stop_motion() { run(rcb4::ops::stop_motion{}, "stop the motion"); }
 
+void board::resume_motion() { run(rcb4::ops::resume_motion(), "resume the motion"); }
+
+std::vector<std::string> board::set_param(bool speed, long long value, const std::vector<std::string>& words) {
+  const char* what = speed ? "speed" : "stretch";
+  if (value < 1 || value > 127)
+    throw board_error(fault::usage, std::string(what) + ": 1..127 (the ICS parameter), not " + std::to_string(value));
+  const auto v = rcb4::servo_param::make(static_cast<int>(value));
+  const auto js = joints_named(words);
+  const auto& map = joints_located();
+  rcb4::servo_mask mask;
+  std::vector<std::string> done;
+  for (const auto* j : js)
+    if (map.block_of(*j)) {
+      mask.insert(j->ics);
+      done.push_back(j->name);
+    }
+  if (mask.empty()) throw board_error(fault::refused, "none of these joints has a servo on the board");
+  run(rcb4::ops::set_servo_param(speed ? rcb4::param_kind::speed : rcb4::param_kind::stretch, *v, mask), what);
+  return done;
+}
+
 motion_status board::motion() {
   const auto st = run(rcb4::ops::read_motion_state(layout()), "motion state");
   return {st.running, st.suspended, st.motion, st.program_counter};
@@ -307,6 +369,7 @@ motion_status board::wait_motion(double seconds, const interrupt_check& check) {
   for (;;) {
     const auto st = motion();
     if (!st.running) return st;
+    if (closing_) throw board_error(fault::closed, "wait_motion: the board was closed");
     if (std::chrono::steady_clock::now() >= deadline)
       throw board_error(fault::timeout, "the motion still runs after " + std::to_string(seconds) + " s");
     std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the board refreshes the state every 50 ms
@@ -337,19 +400,6 @@ sensor_reading board::sensors() {
 std::vector<rcb4::robot::joint_reading> board::states() {
   const auto& map = joints_located();
   return run(rcb4::robot::read_joints(map, rcb4::robot::fields::state, link("read the joints")), "read the joints");
-}
-
-void board::set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent) {
-  std::vector<rcb4::robot::joint_trim> ts;
-  for (const auto& [name, deg] : trims) {
-    const auto* j = model_.find(name);
-    if (!j) throw board_error(fault::usage, "no joint of " + model_.name() + " is called '" + name + "'");
-    const auto t = rcb4::robot::trim_of(*j, deg);
-    if (!rcb4::robot::ok(t)) throw board_error(fault::limit, std::get<rcb4::robot::problem>(t).message);
-    ts.push_back(std::get<rcb4::robot::joint_trim>(t));
-  }
-  if (ts.empty()) return;
-  run(rcb4::robot::write_trims(std::move(ts), persistent), "set the trims");
 }
 
 std::vector<rcb4::ops::slot_probe> board::scan() { return run(rcb4::ops::scan_slots(link("read the joints")), "scan"); }

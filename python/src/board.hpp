@@ -8,8 +8,11 @@
 #include <rcb4/robot/ops.hpp>
 #include <rcb4/robot/profile.hpp>
 #include <rcb4/robot/services/buttons.hpp>
+#include <rcb4/robot/services/host_play.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/record.hpp>
 #include <rcb4/robot/services/rom.hpp>
+#include <rcb4/robot/services/trims.hpp>
 #include <rcb4/transport/board_server.hpp>
 #include <rcb4/transport/client.hpp>
 #include <rcb4/transport/io_thread.hpp>
@@ -17,6 +20,7 @@
 
 #include <boost/asio/posix/stream_descriptor.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -81,8 +85,8 @@ class board {
   bool is_open() const;
   /** What was opened, for messages and repr. */
   const std::string& where() const noexcept { return where_; }
-  /** The line rate in use. */
-  std::uint32_t baud() const;
+  /** The line rate in use; nothing over TCP when it was not given (the bridge's rate is its own). */
+  std::optional<std::uint32_t> baud() const;
   /** The robot model. */
   const rcb4::robot::model& robot() const noexcept { return model_; }
 
@@ -122,8 +126,16 @@ class board {
 
   /** Every joint's block (trim, measured position, target), in the profile's order; unallocated ones marked. */
   std::vector<rcb4::robot::joint_reading> states();
-  /** Writes trims (joint → degrees, within ±30) to RAM, and with @p persistent to HTH4's ROM image. */
-  void set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent);
+  /** Writes trims (joint → degrees, within ±30) to RAM, and with @p persistent to HTH4's ROM image; read back. */
+  rcb4::robot::services::trims_report set_trims(const std::vector<std::pair<std::string, double>>& trims,
+                                                bool persistent);
+  /** Every joint's trim, RAM and ROM (joints without a servo block marked). */
+  std::vector<rcb4::robot::services::trim_entry> trims();
+  /** Sets the ICS speed (@p speed) or stretch parameter to @p value (1..127) on the joints @p words name (none: all).
+   */
+  std::vector<std::string> set_param(bool speed, long long value, const std::vector<std::string>& words);
+  /** Lets the ROM program run again where stop_motion() left it. */
+  void resume_motion();
   /** The allocated servo slots, with their measured positions. */
   std::vector<rcb4::ops::slot_probe> scan();
   /** Sends servos by ICS number to positions (FREE, HOLD or 0..16383) over @p frames, in one CONST. */
@@ -156,6 +168,25 @@ class board {
                                                     const rcb4::robot::services::rom_sink& save, bool force);
   /** The board's VERSION text and output period (for files the services write). */
   rcb4::output_period period();
+  /** What a play from the host did. */
+  struct file_play {
+    std::size_t poses = 0, calls = 0;
+    double seconds = 0;
+    bool interrupted = false;
+    std::vector<std::string> notes;
+  };
+  /**
+   * Plays @p d from the host at the board's timing (rcb4/robot/services/host_play.hpp); @p stop
+   * is asked between waits (true: the play stops, a called ROM motion too), as is close().
+   */
+  file_play play_file(const rcb4::robot::motion_document& d, const std::string& name, bool rescale, double timeout_s,
+                      const std::function<bool()>& stop);
+  /**
+   * Records the joints @p words name (none: all) every @p every_s until @p seconds pass (0: until
+   * @p stop says so, or close()); freed first with @p free and held again at the end.
+   */
+  rcb4::robot::services::record_report record(const std::vector<std::string>& words, double every_s, double seconds,
+                                              double threshold, bool free, const std::function<bool()>& stop);
   /** The layout told from the ROM (cached). */
   const rcb4::rom_layout& rom_layout() { return layout(); }
 
@@ -170,6 +201,10 @@ class board {
   client& c(const char* what);
   rcb4::ops::link_cost link(const char* what);
   void refuse_if_motion_runs(const char* what);
+  /** A failure of @p what: when another program changed the serial line's settings, set again and said so. */
+  [[noreturn]] void fail(const std::error_code& ec, const std::string& what);
+  /** The joints @p words name (joints, groups, "all"; none: all), each once. */
+  std::vector<const rcb4::robot::joint*> joints_named(const std::vector<std::string>& words) const;
   const rcb4::rom_layout& layout();
   const rcb4::robot::joint_map& joints_located();
 
@@ -181,8 +216,12 @@ class board {
   std::unique_ptr<rcb4::transport::io_thread> io_;
   std::unique_ptr<client> client_;
   std::string where_;
-  mutable std::shared_mutex life_;  // calls hold it shared while they use the line; close() waits for them
-  mutable std::mutex state_;        // guards the caches
+  int line_fd_ = -1;  // the serial port's descriptor (owned by client_), or -1
+  std::uint32_t line_baud_ = 0;
+  bool baud_known_ = true;            // false over TCP without a baud: the bridge's rate is its own
+  std::atomic<bool> closing_{false};  // close() has begun: long waits end at their next look
+  mutable std::shared_mutex life_;    // calls hold it shared while they use the line; close() waits for them
+  mutable std::mutex state_;          // guards the caches
   std::optional<rcb4::robot::joint_map> map_;
   const rcb4::rom_layout* layout_ = nullptr;
 };

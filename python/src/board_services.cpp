@@ -7,6 +7,11 @@
 #include <rcb4/ops/layout.hpp>
 #include <rcb4/ops/memory.hpp>
 
+#include <algorithm>
+#include <string_view>
+#include <thread>
+#include <utility>
+
 namespace pyrcb4 {
 
 namespace t = rcb4::transport;
@@ -29,11 +34,48 @@ class client_link final : public sv::link {
   t::response last_;
 };
 
+/**
+ * A service's words for Python: its hints name the rcb4 tool's commands and options (one text for
+ * every front end); here they name the Board's methods and arguments instead.
+ */
+std::string python_words(std::string text) {
+  static constexpr std::pair<std::string_view, std::string_view> words[] = {
+      {"rcb4 motion buttons set", "set_button()"},
+      {"rcb4 motion buttons clear", "clear_button()"},
+      {"rcb4 motion buttons reset", "set_button() for each entry after clearing"},
+      {"rcb4 motion buttons", "buttons()"},
+      {"rcb4 motion show N", "show_motion(n)"},
+      {"rcb4 motion show", "show_motion()"},
+      {"rcb4 motion list", "motions()"},
+      {"rcb4 motion wait", "wait_motion()"},
+      {"rcb4 motion stop", "stop_motion()"},
+      {"rcb4 motion play N", "play_motion(n)"},
+      {"rcb4 motion play", "play_motion()"},
+      {"rcb4 motion push", "push_motion()"},
+      {"rcb4 motion resume", "resume_motion()"},
+      {"motion resume", "resume_motion()"},
+      {"rcb4 rom backup", "rom_backup()"},
+      {"rcb4 rom restore", "rom_restore()"},
+      {"rcb4 read rom", "read(..., memory='rom')"},
+      {"rcb4 scan", "scan()"},
+      {"--no-check", "no_check=True"},
+      {"--hold", "hold=True"},
+      {"--force", "force=True"},
+      {"--joints", "joints="},
+      {"--baud", "baud"},
+  };
+  for (const auto& [tool, py] : words)
+    for (auto at = text.find(tool); at != std::string::npos; at = text.find(tool, at + py.size()))
+      text.replace(at, tool.size(), py);
+  return text;
+}
+
 /** The exception a refusal is in Python. */
 fault fault_of(sv::refusal_kind k) {
   switch (k) {
     case sv::refusal_kind::usage: return fault::usage;
     case sv::refusal_kind::limit: return fault::limit;
+    case sv::refusal_kind::timeout: return fault::timeout;
     case sv::refusal_kind::board:
     case sv::refusal_kind::line: break;
   }
@@ -48,11 +90,12 @@ auto board::service(const char* what, F&& f) {
   try {
     return f(l);
   } catch (const sv::refused& e) {
-    const std::string text = std::string(what) + ": " + e.what() + (e.hint.empty() ? "" : " (" + e.hint + ")");
+    const std::string text =
+        python_words(std::string(what) + ": " + e.what() + (e.hint.empty() ? "" : " (" + e.hint + ")"));
     if (e.kind == sv::refusal_kind::line && e.code) raise(e.code, text);
     throw board_error(fault_of(e.kind), text);
   } catch (const std::system_error& e) {
-    raise(e.code(), what);
+    fail(e.code(), what);
   } catch (const rcb4::robot::profile_error& e) {
     throw board_error(fault::usage, std::string(what) + ": " + e.what());
   }
@@ -85,9 +128,10 @@ sv::push_report board::push_motion(const sv::push_source& src, unsigned n, const
 sv::erase_report board::erase_motion(unsigned n, const std::string& backup) {
   const auto& layout = this->layout();
   return service("erase_motion", [&](sv::link& l) {
-    return sv::erase_motion(l, layout, n, [&](unsigned k, std::span<const std::uint8_t> old) {
-      return sv::save_backup_file(k, old, backup);
-    });
+    return sv::erase_motion(
+        l, layout, n,
+        [&](unsigned k, std::span<const std::uint8_t> old) { return sv::save_backup_file(k, old, backup); },
+        model_.name());
   });
 }
 
@@ -122,6 +166,82 @@ std::vector<std::uint8_t> board::rom_backup() {
 
 sv::restore_report board::rom_restore(std::span<const std::uint8_t> image, const sv::rom_sink& save, bool force) {
   return service("rom_restore", [&](sv::link& l) { return sv::restore_rom(l, image, save, force); });
+}
+
+sv::trims_report board::set_trims(const std::vector<std::pair<std::string, double>>& trims, bool persistent) {
+  return service("set_trims", [&](sv::link& l) { return sv::set_trims(l, model_, trims, persistent); });
+}
+
+std::vector<sv::trim_entry> board::trims() {
+  return service("trims", [&](sv::link& l) { return sv::read_trims(l, model_, {}); });
+}
+
+namespace {
+/** Sleeps until @p t in steps of at most 50 ms; false as soon as @p stop says so. */
+bool sleep_until(std::chrono::steady_clock::time_point t, const std::function<bool()>& stop) {
+  for (;;) {
+    if (stop()) return false;
+    const auto now = std::chrono::steady_clock::now();
+    if (now >= t) return true;
+    std::this_thread::sleep_until(std::min(t, now + std::chrono::milliseconds(50)));
+  }
+}
+}  // namespace
+
+board::file_play board::play_file(const rcb4::robot::motion_document& d, const std::string& name, bool rescale,
+                                  double timeout_s, const std::function<bool()>& stop) {
+  // The layout matters only to a call of another motion by number (as the tool decides it).
+  const bool calls = std::any_of(d.steps.begin(), d.steps.end(),
+                                 [](const auto& st) { return std::holds_alternative<rcb4::robot::motion_call>(st); });
+  const auto& layout = calls ? this->layout() : rcb4::hth4_2_2;
+  const auto board_period = period();
+  const auto stopped = [&] { return closing_ || stop(); };
+  return service("play_motion_file", [&](sv::link& l) {
+    sv::host_play play(l, model_, layout, board_period, d, name, rescale,
+                       std::chrono::milliseconds(static_cast<long long>(timeout_s * 1000)));
+    const auto start = std::chrono::steady_clock::now();
+    const auto elapsed = [&] {
+      return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
+    };
+    file_play r;
+    for (auto next = play.advance(elapsed()); next; next = play.advance(elapsed()))
+      if (!sleep_until(start + *next, stopped)) {
+        play.stop();
+        r.interrupted = true;
+        break;
+      }
+    r.poses = play.poses();
+    r.calls = play.calls();
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    r.notes = play.notes();
+    return r;
+  });
+}
+
+sv::record_report board::record(const std::vector<std::string>& words, double every_s, double seconds, double threshold,
+                                bool free, const std::function<bool()>& stop) {
+  if (!(every_s >= 0.02 && every_s <= 2)) throw board_error(fault::usage, "every: 0.02 to 2 seconds");
+  if (!(seconds >= 0 && seconds <= 3600)) throw board_error(fault::usage, "seconds: 0 (until stopped) to 3600");
+  if (!(threshold >= 0.1 && threshold <= 45)) throw board_error(fault::usage, "threshold: 0.1 to 45 degrees");
+  const auto js = joints_named(words);
+  const auto cost = link("record");
+  const auto stopped = [&] { return closing_ || stop(); };
+  return service("record", [&](sv::link& l) {
+    sv::recording rec(l, model_, js,
+                      {.threshold = threshold, .free = free, .lead_in = std::chrono::seconds(1), .cost = cost});
+    const auto start = std::chrono::steady_clock::now();
+    const auto every =
+        std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(every_s));
+    const auto until =
+        start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+    for (auto next = start;;) {
+      rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start));
+      next += every;
+      if (seconds > 0 && next > until) break;
+      if (!sleep_until(next, stopped)) break;
+    }
+    return rec.finish();
+  });
 }
 
 void board::check_playable(unsigned n, const char* what) {

@@ -61,6 +61,17 @@ inline std::vector<std::string> names_of(const py::args& args) {
   return out;
 }
 
+/** @p v as a number (int, float, numpy scalar); a UsageError naming @p what otherwise. */
+inline double number_of(const py::handle& v, const std::string& what) {
+  if (py::isinstance<py::str>(v) || py::isinstance<py::bool_>(v) || v.is_none())
+    throw board_error(fault::usage, what + " must be a number, not " + py::repr(v).cast<std::string>());
+  try {
+    return v.cast<double>();
+  } catch (const py::cast_error&) {
+    throw board_error(fault::usage, what + " must be a number, not " + py::repr(v).cast<std::string>());
+  }
+}
+
 /** A path given as str or os.PathLike, as os.fspath gives it. */
 inline std::string path_of(const py::object& path) {
   return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();

@@ -5,6 +5,9 @@
 #include "common.hpp"
 
 #include <cstdlib>
+#include <map>
+
+#include <rcb4/robot/services/slot_names.hpp>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -63,6 +66,15 @@ py::dict status_dict(const motion_status& s) {
   return py::dict("running"_a = s.running, "suspended"_a = s.suspended,
                   "motion"_a = s.motion ? py::object(py::int_(*s.motion)) : py::object(py::none()),
                   "program_counter"_a = s.program_counter);
+}
+
+/** The slot names kept for @p b's robot (a names file that does not read: UsageError). */
+std::map<unsigned, std::string> load_names(const board& b) {
+  try {
+    return rcb4::robot::services::load_slot_names(b.robot().name());
+  } catch (const rcb4::robot::services::refused& e) {
+    throw board_error(fault::usage, e.what());
+  }
 }
 
 std::unique_ptr<board> open_board(const py::object& device, const py::object& baud, const std::string& robot,
@@ -153,7 +165,9 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
       .def_property_readonly(
           "closed", [](const board& b) { return !b.is_open(); }, "True after close().")
       .def_property_readonly("where", &board::where, "What was opened.")
-      .def_property_readonly("baud", &board::baud, "The line rate in use.")
+      .def_property_readonly(
+          "baud", &board::baud,
+          "The line rate in use; None over TCP when no baud was given (the bridge's rate is its own).")
       .def("__repr__",
            [](const board& b) { return "<pyrcb4.Board " + b.where() + (b.is_open() ? "" : " (closed)") + ">"; })
       .def("ping", &board::ping, py::call_guard<py::gil_scoped_release>(), "One round trip; its time in seconds.")
@@ -239,13 +253,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             std::vector<std::pair<std::string, double>> ts;
             for (const auto& [k, v] : targets) {
               if (!py::isinstance<py::str>(k)) throw board_error(fault::usage, "move: joint names are strings");
-              double d = 0;
-              try {
-                d = v.cast<double>();
-              } catch (const py::cast_error&) {
-                throw board_error(fault::usage, "move: " + k.cast<std::string>() + ": degrees must be a number");
-              }
-              ts.emplace_back(k.cast<std::string>(), d);
+              ts.emplace_back(k.cast<std::string>(), number_of(v, "move: " + k.cast<std::string>() + ": degrees"));
             }
             const double takes = unlocked([&] { return b.move(ts, time); });
             if (wait) sleep_interruptible(takes);
@@ -253,7 +261,8 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           },
           "targets"_a, "time"_a = 0.5, "wait"_a = true,
           "Moves joints {name: degrees} over time seconds; every limit is checked before anything is sent "
-          "(LimitError names the joint). Returns the seconds the move takes; wait=True waits for them.")
+          "(LimitError names the joint). Returns the seconds the move takes; wait=True waits for them. A freed joint "
+          "is moved too: a position is torque on (the board has no other way to move it; iory/rcb4 drops it instead).")
       .def(
           "free",
           [](board& b, const py::args& names) {
@@ -288,7 +297,34 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           },
           "n"_a, "wait"_a = true, "timeout"_a = 60.0,
           "Plays ROM motion n; wait=True waits until it ends (Ctrl-C interrupts the wait) and returns the state.")
-      .def("stop_motion", &board::stop_motion, py::call_guard<py::gil_scoped_release>(), "Suspends the ROM program.")
+      .def("stop_motion", &board::stop_motion, py::call_guard<py::gil_scoped_release>(),
+           "Suspends the ROM program (resume_motion() continues it).")
+      .def("resume_motion", &board::resume_motion, py::call_guard<py::gil_scoped_release>(),
+           "Lets the ROM program run again where stop_motion() left it (a motion stopped part way goes on).")
+      .def(
+          "stretch",
+          [](board& b, const py::object& value, const py::args& names) {
+            const auto v = number_of(value, "stretch");
+            if (v != std::floor(v)) throw board_error(fault::usage, "stretch: a whole number 1..127");
+            const auto n = names_of(names);
+            py::gil_scoped_release release;
+            return b.set_param(false, static_cast<long long>(v), n);
+          },
+          "value"_a,
+          "Sets the ICS stretch (holding stiffness, 1..127; 127 the stiffest) of joints or groups (none: all); returns "
+          "the joints set. The board cannot read it back.")
+      .def(
+          "speed",
+          [](board& b, const py::object& value, const py::args& names) {
+            const auto v = number_of(value, "speed");
+            if (v != std::floor(v)) throw board_error(fault::usage, "speed: a whole number 1..127");
+            const auto n = names_of(names);
+            py::gil_scoped_release release;
+            return b.set_param(true, static_cast<long long>(v), n);
+          },
+          "value"_a,
+          "Sets the ICS speed (output limit, 1..127; 127 the fastest) of joints or groups (none: all); returns the "
+          "joints set. Not a move's time: that is move(time=...).")
       .def(
           "motion_status",
           [](board& b) {
@@ -314,9 +350,10 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "motions",
           [](board& b) {
             const std::vector<rcb4::ops::motion_slot> v = unlocked([&] { return b.motions(); });
+            const auto names = load_names(b);
             py::list out;
             for (const auto& s : v) {
-              const auto name = b.robot().motion(s.number);
+              const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names);
               out.append(
                   py::dict("slot"_a = s.number,
                            "name"_a = name.empty() ? py::object(py::none()) : py::object(py::str(std::string(name))),
@@ -324,7 +361,8 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             }
             return out;
           },
-          "The used motion slots in ROM: slot, name (from the profile), address, size, frames.")
+          "The used motion slots in ROM: slot, name (the slot's name, kept when a motion file with a name is pushed; "
+          "else the profile's), address, size, frames (the protocol's commands walked to the first RETURN).")
       .def(
           "sensors",
           [](board& b) {

@@ -18,6 +18,13 @@ def pytest_addoption(parser):
     parser.addoption("--rcb4", default=os.environ.get("RCB4", "rcb4"), help="the rcb4 tool (for rcb4 serve)")
 
 
+@pytest.fixture(autouse=True)
+def _in_a_temporary_directory(tmp_path, monkeypatch):
+    """Every test runs in its own directory: a backup a call makes (motion-N-DATE.bin) lands there, never in the tree."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("RCB4_SLOT_NAMES", str(tmp_path / "slot-names.yaml"))  # names a push keeps, per test
+
+
 @pytest.fixture(scope="session")
 def rcb4_tool(request):
     return request.config.getoption("--rcb4")

@@ -130,7 +130,7 @@ def test_buttons(board):
     assert "up+s1" not in [e["buttons"] for e in r["entries"]]
     with pytest.raises(pyrcb4.BoardRefused, match="no entry plays anything"):
         board.clear_button("s1+up")
-    with pytest.raises(pyrcb4.BoardRefused, match="--hold"):
+    with pytest.raises(pyrcb4.BoardRefused, match="hold=True"):
         board.press("triangle+square")
     held = board.press("triangle+square", hold=True)
     assert held["held"] and not held["entry"] and board.read(0x0350, 2) != b"\x00\x00"

@@ -65,7 +65,7 @@ pose parse_pose(std::string_view text, const std::string& source, const model& m
 model parse_profile_nodes(std::string_view text, const std::string& source) {
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw profile_error(source, "a profile is a mapping with robot, joints, groups, motions");
-  check_keys(source, root, {"robot", "joints", "groups", "motions"}, "profile");
+  check_keys(source, root, {"robot", "joints", "groups", "motions", "kinematics"}, "profile");
   const std::string name = root["robot"] ? scalar(source, root["robot"], "robot") : std::string("robot");
   const YAML::Node js = root["joints"];
   if (!js || !js.IsMap() || js.size() == 0)
@@ -103,9 +103,16 @@ model parse_profile_nodes(std::string_view text, const std::string& source) {
       motions.push_back({slot, scalar(source, kv.second, "motion name")});
     }
   }
+  std::vector<std::string> names;
+  for (const auto& j : joints) names.push_back(j.name);
   auto m = model::make(name, std::move(joints), std::move(groups), std::move(motions));
   if (!ok(m)) throw profile_error(source, std::get<problem>(m).message);
-  return std::get<model>(std::move(m));
+  auto out = std::get<model>(std::move(m));
+  if (const YAML::Node k = root["kinematics"]) {
+    if (const auto p = out.attach_body(parse_body(source, k, names)))  // parse_body has checked it: never
+      throw profile_error(source, "kinematics: " + p->message);
+  }
+  return out;
 }
 
 model load_profile(const std::filesystem::path& path) { return parse_profile(read_file(path), path.string()); }

@@ -110,4 +110,7 @@ inline void check_keys(const std::string& source, const YAML::Node& map,
   }
 }
 
+/** A profile's `kinematics:` node, checked against the profile's joints; a profile_error at the entry at fault. */
+kinematics parse_body(const std::string& source, const YAML::Node& n, const std::vector<std::string>& profile_joints);
+
 }  // namespace rcb4::robot::detail

@@ -152,9 +152,53 @@ try:
           f"a 3 s segment (more than 255 periods) reaches its point, within 1 deg ({last_position('left_knee')})")
     wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
 
-    # An empty ~free_joints names nothing: it frees nothing (a robot would fall), and says so.
+    # Stop (the trial's finding): an empty trajectory, and ~stop, hold every joint where it is now;
+    # the segment under way does not run on to its end.
+    for how in ("an empty trajectory", "~stop"):
+        trajectory([(-60, 2.2)])
+        time.sleep(0.6)
+        if how == "~stop":
+            r = rospy.ServiceProxy("/rcb4/stop", Trigger)()
+            check(r.success and "holds where it is" in r.message, f"~stop answers ({r.message!r})")
+        else:
+            cmd.publish(JointTrajectory(joint_names=["left_knee"]))
+        time.sleep(0.1)
+        at = last_position("left_knee")
+        time.sleep(1.2)
+        now = last_position("left_knee")
+        check(-50 < at < 30 and abs(now - at) < 3,
+              f"{how} stops the segment under way: left_knee stays at {at:.1f} (now {now:.1f}), not -60")
+        trajectory([(35, 0.5)])
+        wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5)
+    # Free during a trajectory: the freed joint stays free; its next points are dropped, said so.
     free_joints = rospy.Publisher("/rcb4/free_joints", String, queue_size=2)
-    wait_for(lambda: free_joints.get_num_connections() > 0)
+    hold_joints = rospy.Publisher("/rcb4/hold_joints", String, queue_size=2)
+    wait_for(lambda: free_joints.get_num_connections() > 0 and hold_joints.get_num_connections() > 0)
+    trajectory([(50, 0.5), (60, 1.0), (80, 2.0)])
+    time.sleep(0.6)
+    free_joints.publish(String("left_knee"))
+    time.sleep(0.2)
+    at = last_position("left_knee")
+    time.sleep(1.8)
+    check(abs(last_position("left_knee") - at) < 3,
+          f"a trajectory's next points do not power a freed joint: left_knee stays at {at:.1f} "
+          f"(now {last_position('left_knee'):.1f}), not 80")
+    stream.publish(JointState(name=["left_knee"], position=[math.radians(10)]))
+    time.sleep(0.5)
+    check(abs(last_position("left_knee") - at) < 3, f"a streamed command does not move a freed joint ({last_position('left_knee')})")
+    hold_joints.publish(String("left_knee"))
+    time.sleep(0.3)
+    trajectory([(35, 0.5)])
+    check(wait_for(lambda: abs(last_position("left_knee") - 35) < 0.5, timeout=5) is not None,
+          "held again, left_knee follows a trajectory")
+    # Two different refusals in a row are both logged (repeats of one are limited, not all refusals).
+    bad = JointTrajectory(joint_names=["no_such_joint"],
+                          points=[JointTrajectoryPoint(positions=[0.0], time_from_start=rospy.Duration(0.5))])
+    cmd.publish(bad)
+    trajectory([(140, 0.5)])
+    time.sleep(0.5)
+
+    # An empty ~free_joints names nothing: it frees nothing (a robot would fall), and says so.
     free_joints.publish(String(" "))
     time.sleep(0.3)
     free = rospy.ServiceProxy("/rcb4/free", Trigger)
@@ -166,6 +210,10 @@ try:
     check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
     check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
     check("motion 3 is running on the board" in out, "the trajectory refused under motion 3 is logged")
+    check("no joint is called 'no_such_joint'" in out and out.count("beyond its upper limit 130") >= 2,
+          "two different refusals in a row are each logged")
+    check("what was under way for left_knee is dropped" in out and "left_knee is free: left out" in out,
+          "freeing a joint under way and commanding a freed joint are logged")
     check("~free_joints: the message names no joint, so nothing was done" in out, "an empty ~free_joints is refused, logged")
     j = tool_joints(dev)
     check(j and abs(j["left_knee"]["degrees"] - 35) < 1 and all(v["state"] == "free" for v in j.values()),

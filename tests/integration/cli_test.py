@@ -516,4 +516,49 @@ check(time.monotonic() - t0 < 3, "read --output into a bad path fails before the
 rc, out, err = run("--json", "--device", "tcp:" + "127.0.0.1:1", "--baud", "1250000", "config", "set", "baud=625000")
 check(rc != 0, "config set baud= over TCP does not claim the bridge followed")
 
+# ---- rcb4 urdf: the robot for rviz and MoveIt, checked by Debian's URDF parser (liburdfdom-tools) ----
+import shutil  # noqa: E402
+import tempfile  # noqa: E402
+for robot, root, joints in (("khr-3hv", "pelvis", 20), ("kxr-l2", "torso", 17)):
+    rc, out, err = run("--robot", robot, "urdf")
+    check(rc == 0 and out.count('type="revolute"') == joints, f"rcb4 --robot {robot} urdf: {joints} joints ({rc}: {err.strip()!r})")
+    if shutil.which("check_urdf"):
+        with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
+            f.write(out)
+        p = subprocess.run(["check_urdf", f.name], capture_output=True, text=True)
+        os.unlink(f.name)
+        check(p.returncode == 0 and "Successfully Parsed XML" in p.stdout and f"root Link: {root}" in p.stdout,
+              f"check_urdf parses it, root {root} ({p.returncode}: {p.stdout[:120]!r} {p.stderr[:200]!r})")
+    else:
+        check(False, "check_urdf (liburdfdom-tools) is installed: cmake/install-deps.sh installs it")
+expect_rc(["--robot", os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "profiles", "missing.yaml"),
+           "urdf"], 2, "missing.yaml")
+with tempfile.NamedTemporaryFile("w", suffix=".yaml", delete=False) as f:
+    f.write("robot: bare\njoints:\n  a: {ics: 1, lower: -10, upper: 10}\n")
+expect_rc(["--robot", f.name, "urdf"], 2, "has no kinematics")
+os.unlink(f.name)
+
+# ---- serve --hand: a script poses a freed joint, as a person would -------------------------------
+hand = subprocess.Popen([RCB4, "serve", "--pty", "--hand"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                        stderr=subprocess.PIPE, text=True, bufsize=1)
+hand_dev = hand.stdout.readline().strip()
+hand.stdin.write("left_knee 30\n")
+hand.stdin.flush()
+err_line = hand.stderr.readline()
+check("left_knee: its servo holds its position: free it first" in err_line, f"--hand leaves a held joint alone ({err_line!r})")
+rc, out, err = run("--device", hand_dev, "joint", "free", "left_knee")
+hand.stdin.write("left_knee 30\n")
+hand.stdin.flush()
+said = hand.stdout.readline()
+rc, out, err = run("--json", "--device", hand_dev, "joint", "list")
+knee = [j for j in json.loads(out) if j["name"] == "left_knee"][0] if rc == 0 else {}
+check("hand turned left_knee to 30" in said and abs(knee.get("degrees", 99) - 30) < 0.5,
+      f"--hand turns a freed joint, and the board measures it there ({said!r}, {knee.get('degrees')})")
+hand.stdin.write("no_such 3\n")
+hand.stdin.flush()
+check("expected JOINT DEGREES" in hand.stderr.readline(), "--hand: a line that names no joint is answered on stderr")
+hand.stdin.close()
+hand.terminate()
+check(hand.wait(timeout=10) == 0, "serve --hand ends on SIGTERM with 0")
+
 finish()

@@ -103,7 +103,7 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     # Push the hand-written file: the bytes by hand, the old (erased) slot backed up.
     rc, out, err = run(*on, "motion", "push", "knee.yaml", "5")
     check(rc == 0 and "wrote 53 bytes to motion 5 (0x002B80..0x002BB4" in out and "read them back" in out
-          and "6 steps, 1 pose (0.30 s of moves)" in out, f"motion push knee.yaml 5 ({rc}: {out.strip()!r} {err.strip()!r})")
+          and "6 steps, 1 pose (plays 0.90 s, no button held)" in out, f"motion push knee.yaml 5 ({rc}: {out.strip()!r} {err.strip()!r})")
     check(rom(on, 0x2B80, len(knee_at_5)) == knee_at_5, "ROM 0x002B80 holds the bytes written by hand")
     backups = glob.glob("motion-5-*.bin")
     check(len(backups) == 1 and open(backups[0], "rb").read() == b"\xff" * 2048,
@@ -128,6 +128,29 @@ with serve("--rom", rom_file, "--period", "15") as dev:
           and '- if_buttons: "up"\n    goto: L2B88' in back and err == "", f"pull 5: the file written by hand, back ({back[-200:]!r} {err!r})")
     rc, out, err = run(*on, "motion", "push", "knee-back.yaml", "5")
     check(rc == 0 and "nothing written" in out, f"the pulled file assembles to the same bytes ({rc}: {out.strip()!r})")
+
+    # A motion file's name names its slot (the board keeps no names): motion list, show and pull
+    # say it, pyrcb4 and rcb4 ui read the same file; an erase forgets it.
+    os.environ["RCB4_SLOT_NAMES"] = os.path.join(work, "slot-names.yaml")
+    write("named.yaml", open("knee.yaml").read().replace("robot: KHR-3HV", "robot: KHR-3HV\nname: knee bends"))
+    rc, out, err = run(*on, "motion", "push", "named.yaml", "6", "--backup", "six-named.bin")
+    check(rc == 0 and "motion 6 'knee bends'" in out, f"push of a named file names the slot ({rc}: {out.strip()!r})")
+    rc, out, err = run("--json", *on, "motion", "list")
+    names = {m["slot"]: m["name"] for m in json.loads(out)["motions"]} if rc == 0 else {}
+    check(names.get(6) == "knee bends", f"motion list shows the slot's name ({names})")
+    rc, out, err = run(*on, "motion", "show", "6")
+    check(rc == 0 and "motion 6 (knee bends)" in out, f"motion show names it ({out[:80]!r})")
+    rc, out, err = run(*on, "motion", "pull", "6", "named-back.yaml")
+    check(rc == 0 and "knee bends" in open("named-back.yaml").read(), "a pull keeps the name")
+    rc, out, err = run(*on, "motion", "erase", "6", "--backup", "six-erased.bin")
+    rc, out, err = run("--json", *on, "motion", "list")
+    names = {m["slot"]: m["name"] for m in json.loads(out)["motions"]} if rc == 0 else {}
+    check(rc == 0 and 6 not in names and "knee bends" not in open("slot-names.yaml").read(),
+          "an erase forgets the slot's name")
+    # Play time as the board plays it: the loop counted (3 passes of 300 ms), no button held.
+    rc, out, err = run("--json", *on, "motion", "list")
+    times = {m["slot"]: m["seconds"] for m in json.loads(out)["motions"]} if rc == 0 else {}
+    check(times.get(5) == 0.9, f"motion list: motion 5 plays 0.9 s, its loop counted ({times.get(5)})")
 
     # Another output period: refused, or rescaled on request.
     write("knee10.yaml", open("knee.yaml").read().replace("period_ms: 15", "period_ms: 10"))

@@ -124,6 +124,17 @@ with serve("--period", "15") as dev:
           f"a chain of 16 calls (17 levels) refused at push, nothing written ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "push", "c44.yaml", "44", "--dry-run")
     check(rc == 1 and "17 levels" in err, f"--dry-run refuses it too ({rc}: {err.strip()!r})")
+    # The chain deepened from its end: the callers are checked again. Motion 60 calling 61 would
+    # make motion 45 (which reaches 60 through 46..59) need 17 levels: refused, nothing written.
+    run(*on, "motion", "push", "nod.yaml", "61", "--backup", "c61.bin")
+    write("c60deep.yaml", HEAD + "  - call: 61\n  - end\n")
+    before60 = rom(on, slot(60), 16)
+    rc, out, err = run(*on, "motion", "push", "c60deep.yaml", "60", "--backup", "c60d.bin")
+    check(rc == 1 and f"motion 45 (0x{slot(45):06X}) calls it" in err and "17 levels" in err
+          and rom(on, slot(60), 16) == before60 and not os.path.exists("c60d.bin"),
+          f"a push that deepens a chain from its end: refused for its caller, nothing written ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "c60deep.yaml", "60", "--dry-run")
+    check(rc == 1 and "calls it" in err, f"--dry-run refuses it too ({rc}: {err.strip()!r})")
     # Mutual recursion: 70 calls 71, then 71 calling 70 is refused.
     run(*on, "motion", "push", "nod.yaml", "71", "--backup", "m71.bin")
     write("c70.yaml", HEAD + "  - call: 71\n  - end\n")

@@ -16,6 +16,7 @@ import tempfile
 import time
 
 from checks import check, finish
+from uihelp import tools
 from wsclient import WebSocket, http_get
 
 RCB4 = sys.argv[1]
@@ -26,56 +27,7 @@ KHR = ["head_yaw", "waist_yaw", "left_shoulder_pitch", "right_shoulder_pitch", "
        "left_ankle_pitch", "right_ankle_pitch", "left_ankle_roll", "right_ankle_roll"]  # profiles/khr-3hv.yaml
 
 
-def run(*args, timeout=60):
-    p = subprocess.run([RCB4, *args], capture_output=True, text=True, timeout=timeout)
-    return p.returncode, p.stdout, p.stderr
-
-
-@contextlib.contextmanager
-def serve():
-    srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
-    try:
-        yield srv.stdout.readline().strip()
-    finally:
-        srv.terminate()
-        srv.wait(timeout=10)
-
-
-class Ui:
-    """`rcb4 ui ARGS` running; .url, .port; stop() ends it with SIGINT and returns its exit code."""
-
-    def __init__(self, *args):
-        self.p = subprocess.Popen([RCB4, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        self.url = self.p.stdout.readline().strip()
-        m = re.match(r"http://[^/]*:(\d+)/", self.url)
-        self.port = int(m.group(1)) if m else 0
-
-    def stop(self):
-        if self.p.poll() is None:
-            self.p.send_signal(signal.SIGINT)
-        try:
-            rc = self.p.wait(timeout=15)
-        except subprocess.TimeoutExpired:
-            self.p.kill()
-            rc = "hung"
-        self.err = self.p.stderr.read()
-        return rc
-
-
-def joints_on(dev):
-    rc, out, err = run("--json", "--device", dev, "joint", "list")
-    assert rc == 0, err
-    return {j["name"]: j for j in json.loads(out)}
-
-
-def browser():
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-    o = webdriver.ChromeOptions()
-    o.binary_location = "/usr/bin/chromium"
-    for a in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--window-size=1400,1080"):
-        o.add_argument(a)
-    return webdriver.Chrome(service=Service("/usr/bin/chromedriver"), options=o)
+run, serve, Ui, browser, wait_until, joints_on = tools(RCB4)
 
 
 def closed_within(ws, seconds):
@@ -88,16 +40,6 @@ def closed_within(ws, seconds):
         except OSError:
             return False
     return False
-
-
-def wait_until(pred, timeout=10, step=0.05):
-    end = time.time() + timeout
-    while time.time() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(step)
-    return pred()
 
 
 with serve() as dev, tempfile.TemporaryDirectory() as poses:
@@ -115,7 +57,7 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     check(busy.returncode == 3 and "cannot listen on" in busy.stderr and "127.0.0.1:0" in busy.stderr,
           f"a port in use: exit 3 with the fix ({busy.returncode}, {busy.stderr.strip()!r})")
     status, h, body = http_get(ui.port, "/")
-    check(status == 200 and h["content-type"].startswith("text/html") and b"<title>rcb4 ui</title>" in body,
+    check(status == 200 and h["content-type"].startswith("text/html") and b"<title>rcb4 studio</title>" in body,
           "GET / serves the embedded page")
     check("default-src 'none'" in h.get("content-security-policy", ""), "with a Content-Security-Policy")
     for path in ("/app.js", "/style.css"):
@@ -159,8 +101,8 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     check(errors == 10, f"ten bad messages, ten errors ({errors})")
     a.send({"op": "refresh", "id": 77})
     check(a.wait_for(lambda m: m["type"] == "reply" and m["id"] == 77) is not None, "and the server still answers")
-    a.send_text("x" * 20000)
-    check(closed_within(a, 5), "a message over 16 KiB closes that page's socket")
+    a.send_text("x" * 70000)
+    check(closed_within(a, 5), "a message over 64 KiB closes that page's socket")
     # The controller went with it: a second page may take control; then it vanishes mid-move.
     took = None
     for attempt in range(30):  # the server learns of the closed page a moment after the client does
@@ -283,6 +225,7 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: driver.find_element(By.ID, "role").text == "controlling"), "the page controls")
         # The slider, moved the way a person does with the keyboard: focus it, End.
         slider = driver.find_element(By.CSS_SELECTOR, 'input[data-joint="head_yaw"]')
+        driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", slider)  # not under the sticky header
         slider.click()
         slider.send_keys(Keys.END)
         target = lambda: driver.find_element(By.CSS_SELECTOR, '.joint[data-joint="head_yaw"] .target').get_attribute(
@@ -309,6 +252,7 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(item and os.path.exists(saved), "capture: the pose is listed and saved as look_left.yaml")
         check(os.path.exists(saved) and re.search(r"head_yaw:\s*90\b", open(saved).read()), "with head_yaw at 90")
         slider = driver.find_element(By.CSS_SELECTOR, 'input[data-joint="head_yaw"]')
+        driver.execute_script("arguments[0].scrollIntoView({block: 'center'})", slider)  # not under the sticky header
         slider.click()
         slider.send_keys(Keys.HOME)
         check(wait_until(lambda: driver.find_element(

@@ -79,6 +79,7 @@ class WebSocket:
     def recv(self, timeout=5):
         """The next text message as an object (pings answered); None when the server closed."""
         self.sock.settimeout(timeout)
+        parts = []  # a message the server sent in fragments (text, then continuations until FIN)
         while True:
             try:
                 b0, b1 = self._read(2)
@@ -101,8 +102,10 @@ class WebSocket:
             if op == 9:
                 self.send_text(payload, opcode=10)
                 continue
-            if op == 1:
-                return json.loads(payload)
+            if op in (0, 1):
+                parts.append(payload)
+                if b0 & 0x80:  # FIN: the message is whole
+                    return json.loads(b"".join(parts))
 
     def wait_for(self, pred, timeout=5):
         """Messages until one satisfies @pred; returns it (None at the deadline or close)."""

@@ -4,6 +4,9 @@
 #include "app.hpp"
 
 #include <ctime>
+#include <future>
+
+#include <boost/asio/post.hpp>
 
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
@@ -197,6 +200,22 @@ session::~session() {
   client_.reset();
   rcb4::transport::board_server::shutdown(server_);  // before board_io_'s context goes
   board_io_.reset();                                 // joins the board's thread
+}
+
+std::optional<std::uint16_t> session::by_hand(rcb4::ics_number n, std::uint16_t position) {
+  if (!board_) return std::nullopt;
+  // The board lives on its own io thread: the hand turns it there, and this waits (1 s at most).
+  auto done = std::make_shared<std::promise<std::optional<std::uint16_t>>>();
+  auto answer = done->get_future();
+  boost::asio::post(board_io_->context(), [done, n, position, b = board_.get()] {
+    const auto block = b->block_of(n);
+    if (!block) return done->set_value(std::nullopt);
+    const auto target = b->ram16(*block + rcb4::servo_block::target.offset);
+    if (target == 0x8000) b->turn_by_hand(n, position);
+    done->set_value(target);
+  });
+  if (answer.wait_for(std::chrono::seconds(1)) != std::future_status::ready) return std::nullopt;
+  return answer.get();
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -48,9 +48,17 @@ struct failure : std::runtime_error {
   nlohmann::ordered_json extra;  ///< facts for --json (e.g. how far a transfer got), or null
 };
 
-/** The exit code of a robot service's refusal: board 1, usage and limit 2. */
+/** The exit code of a robot service's refusal: board 1, usage and limit 2, timeout 4, a failed line 3. */
 constexpr int exit_of(rcb4::robot::services::refusal_kind k) noexcept {
-  return k == rcb4::robot::services::refusal_kind::board ? exit_board : exit_usage;
+  using rcb4::robot::services::refusal_kind;
+  switch (k) {
+    case refusal_kind::board: return exit_board;
+    case refusal_kind::usage:
+    case refusal_kind::limit: return exit_usage;
+    case refusal_kind::timeout: return exit_timeout;
+    case refusal_kind::line: break;
+  }
+  return exit_io;
 }
 
 /** A command-line mistake found after parsing (a value out of range, a servo given twice): exit 2. */
@@ -137,6 +145,12 @@ class session {
   const std::string& where() const noexcept { return where_; }
   /** True when no --device was given. */
   bool is_virtual() const noexcept { return board_ != nullptr; }
+  /**
+   * The virtual board's hand: turns ICS @p n to @p position when its servo is free (on the
+   * board's own thread). Returns the servo's output word (+6: 0x8000 when it was free and turned),
+   * or nothing without a virtual board or a block for @p n, or when the board did not answer in 1 s.
+   */
+  std::optional<std::uint16_t> by_hand(rcb4::ics_number n, std::uint16_t position);
   /** Runs @p op; throws rcb4::transport::system_error on failure. */
   template <rcb4::ops::Operation Op>
   auto run(Op op) {
@@ -273,6 +287,7 @@ void add_serve_command(CLI::App& app, context& ctx);   ///< serve (cmd_serve.cpp
 void add_robot_commands(CLI::App& app, context& ctx);  ///< joint, pose, trim, scan (cmd_robot.cpp)
 void add_ui_command(CLI::App& app, context& ctx);      ///< ui (cmd_ui.cpp, ui/)
 void add_rom_commands(CLI::App& app, context& ctx);    ///< rom backup|restore (cmd_rom.cpp)
+void add_urdf_command(CLI::App& app, context& ctx);    ///< urdf (cmd_urdf.cpp)
 // Shared by the robot commands (cmd_robot.cpp) and motion record (cmd_record.cpp).
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
 bool wait_for_enter();

@@ -7,6 +7,7 @@
 #include <rcb4/ops/layout.hpp>
 #include <rcb4/robot/services/buttons.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
 
 namespace cli {
 namespace {
@@ -22,7 +23,7 @@ std::string target_text(std::uint32_t a, const rcb4::rom_layout& layout, const r
   if (a >= layout.motion_base.value() && (a - layout.motion_base.value()) % layout.slot_size == 0) {
     const auto k = (a - layout.motion_base.value()) / layout.slot_size + 1;
     if (k <= layout.motion_count) {
-      const auto name = robot.motion(k);
+      const auto name = rcb4::robot::services::slot_name(robot, k);
       return fmt::format("motion {}{} (0x{:06X})", k, name.empty() ? "" : fmt::format(" \"{}\"", name), a);
     }
   }

@@ -4,6 +4,7 @@
 #include "app.hpp"
 
 #include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
 
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/ops/layout.hpp>
@@ -124,8 +125,7 @@ std::pair<double, rcb4::ops::motion_state> wait(session& s, const rcb4::rom_layo
 int play(session& s, unsigned n, bool release, bool and_wait, const motion_options& o, const globals& g) {
   const auto& layout = layout_for(s, o);
   if (n > layout.motion_count)
-    throw usage_error(
-        fmt::format("motion number: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
+    throw usage_error(fmt::format("N: {} is outside 1..{} ({} layout)", n, layout.motion_count, layout.name));
   {
     // An empty or broken slot (as motion list marks it) would stop the board's program: refused first.
     session_link link(s, g.json);
@@ -173,7 +173,7 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   const auto l = m::disassemble(bytes, *where);
   const auto lifted = empty ? m::outcome<m::program>{m::failure{"the slot is empty"}} : m::lift(l);
   json code = json::array();
-  const auto motion_name = robot.motion(static_cast<unsigned>(n));
+  const auto motion_name = rcb4::robot::services::slot_name(robot, static_cast<unsigned>(n));
   if (!g.json)
     fmt::print("motion {}{} at 0x{:06X} ({} layout, slot of {} bytes){}\n", n,
                motion_name.empty() ? std::string() : fmt::format(" ({})", motion_name), where->address.value(),
@@ -300,7 +300,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     }
     if (po->rescale) throw usage_error("--rescale is for a motion file; motion N plays the ROM's frames as they are");
     const long long n = po->what.size() > 4 ? 0 : std::stoll(po->what);
-    if (n < 1 || n > 120) throw usage_error(fmt::format("motion number: {} is outside 1..120", po->what));
+    if (n < 1 || n > 120) throw usage_error(fmt::format("N: {} is outside 1..120", po->what));
     ctx.action = [&ctx, po, n] {
       session s(ctx.g);
       return play(s, static_cast<unsigned>(n), po->release, po->wait, po->m, ctx.g);
@@ -367,9 +367,28 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     if (ec) throw rcb4::transport::system_error(ec);
     json arr = json::array();
     // "commands": the frames of the protocol walked to the first RETURN, not interpolation frames.
-    if (!ctx.g.json) fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {}\n", "slot", "name", "address", "bytes", "commands");
+    if (!ctx.g.json)
+      fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {:>8}  {:>8}  {}\n", "slot", "name", "address", "bytes", "commands",
+                 "seconds", "");
+    const auto period = s.run(rcb4::ops::read_config{}).period;
+    const auto names = rcb4::robot::services::load_slot_names(m.name());
     for (const auto& v : op.value()) {
-      const auto name = m.motion(v.number);
+      const auto name = rcb4::robot::services::slot_name(m, v.number, names);
+      // Its time as the board plays it (loops counted), where the code is one the steps express.
+      std::optional<rcb4::motion::play_estimate> plays;
+      if (v.ends) {
+        const rcb4::motion::slot where{rcb4::rom_address::make(v.address).value(), layout.slot_size};
+        if (auto p = rcb4::motion::lift(rcb4::motion::disassemble(v.code, where)); rcb4::motion::ok(p))
+          plays = rcb4::motion::play_time(std::get<rcb4::motion::program>(p));
+      }
+      const auto seconds = [&]() -> std::optional<double> {
+        if (!plays || plays->endless || !plays->error.empty()) return std::nullopt;
+        return std::round(static_cast<double>(plays->frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
+      }();
+      const std::string seconds_text = !plays           ? "-"
+                                       : plays->endless ? "for ever"
+                                       : seconds        ? fmt::format("{:.2f}", *seconds)
+                                                        : "-";
       const std::string note = !v.readable ? "not a frame: another --layout?" : v.ends ? "" : "no RETURN found";
       if (ctx.g.json)
         arr.push_back({{"slot", v.number},
@@ -378,11 +397,13 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                        {"size", v.size},
                        {"frames", v.frames},  // kept for scripts: the same count as "commands"
                        {"commands", v.frames},
+                       {"seconds", seconds ? json(*seconds) : json(nullptr)},  // loops counted; calls not
+                       {"endless", plays && plays->endless},
                        {"ends", v.ends},
                        {"readable", v.readable}});
       else
-        fmt::print("{:>4}  {:<20} 0x{:05X}  {:>6}  {:>6}  {}\n", v.number, name.empty() ? "-" : name, v.address, v.size,
-                   v.frames, note);
+        fmt::print("{:>4}  {:<20} 0x{:05X}  {:>6}  {:>8}  {:>8}  {}\n", v.number, name.empty() ? "-" : name, v.address,
+                   v.size, v.frames, seconds_text, note);
     }
     if (ctx.g.json)
       emit(json{{"layout", layout.name}, {"motions", arr}});

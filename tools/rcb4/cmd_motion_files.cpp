@@ -6,6 +6,7 @@
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/motion/player.hpp>
 #include <rcb4/robot/motion_file.hpp>
+#include <rcb4/robot/services/host_play.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
 
 #include <fmt/format.h>
@@ -77,12 +78,13 @@ int pull(session& s, const pull_options& o, const globals& g) {
               {"steps", r.document.steps.size()},
               {"poses", r.poses},
               {"pose_ms", r.pose_ms},
+              {"plays", r.plays},
               {"period_ms", rcb4::milliseconds(r.period)},
               {"problem", r.beyond.empty() ? json(nullptr) : json(r.beyond)}});
   } else {
-    fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({:.2f} s of moves at {} ms frames) -> {}\n", n,
-               r.address, layout.name, r.bytes, r.document.steps.size(), plural(r.poses, "pose"),
-               static_cast<double>(r.pose_ms) / 1000, rcb4::milliseconds(r.period), o.file);
+    fmt::print("motion {} (0x{:06X}, {} layout): {} bytes, {} steps, {} ({}, {} ms frames) -> {}\n", n, r.address,
+               layout.name, r.bytes, r.document.steps.size(), plural(r.poses, "pose"), r.plays,
+               rcb4::milliseconds(r.period), o.file);
     if (!r.beyond.empty()) fmt::print(stderr, "note: as it is, the file would not push back: {}\n", r.beyond);
   }
   return exit_ok;
@@ -136,10 +138,14 @@ int push(session& s, const push_options& o, const globals& g) {
   }
   if (r.unchanged) {
     if (g.json)
-      emit(json{{"pushed", n}, {"address", r.address}, {"bytes", r.bytes.size()}, {"unchanged", true}});
+      emit(json{{"pushed", n},
+                {"address", r.address},
+                {"bytes", r.bytes.size()},
+                {"unchanged", true},
+                {"name", r.name.empty() ? json(nullptr) : json(r.name)}});
     else
-      fmt::print("motion {} (0x{:06X}) already holds these {}: nothing written\n", n, r.address,
-                 plural(r.bytes.size(), "byte"));
+      fmt::print("motion {} (0x{:06X}) already holds these {}: nothing written{}\n", n, r.address,
+                 plural(r.bytes.size(), "byte"), r.name.empty() ? "" : fmt::format(" (named '{}')", r.name));
     return exit_ok;
   }
   warn_buttons(s, mo::slot_of(layout, n).value(), n, "a press plays the new one", g);
@@ -150,10 +156,12 @@ int push(session& s, const push_options& o, const globals& g) {
               {"bytes", r.bytes.size()},
               {"unchanged", false},
               {"backup", r.backup},
+              {"name", r.name.empty() ? json(nullptr) : json(r.name)},
               {"notes", r.notes}});
   } else {
-    fmt::print("wrote {} to motion {} (0x{:06X}..0x{:06X}, {} layout) and read them back: {}\n",
-               plural(r.bytes.size(), "byte"), n, r.address, r.address + r.bytes.size() - 1, layout.name, r.summary);
+    fmt::print("wrote {} to motion {}{} (0x{:06X}..0x{:06X}, {} layout) and read them back: {}\n",
+               plural(r.bytes.size(), "byte"), n, r.name.empty() ? "" : fmt::format(" '{}'", r.name), r.address,
+               r.address + r.bytes.size() - 1, layout.name, r.summary);
     fmt::print("the slot's old bytes are in {} (rcb4 motion push {} {} puts them back)\n", r.backup, r.backup, n);
   }
   return exit_ok;
@@ -164,7 +172,7 @@ int erase(session& s, const push_options& o, const globals& g) {
   sv::slot_for(layout, o.n);  // a number outside the layout before anything else
   const auto n = static_cast<unsigned>(o.n);
   session_link link(s, g.json);
-  const auto r = sv::erase_motion(link, layout, n, backup_to(o.backup));
+  const auto r = sv::erase_motion(link, layout, n, backup_to(o.backup), robot_of(g).name());
   if (r.unchanged) {
     if (g.json)
       emit(json{{"erased", n}, {"address", r.address}, {"unchanged", true}});
@@ -213,124 +221,50 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
   const bool calls = std::any_of(d.steps.begin(), d.steps.end(),
                                  [](const auto& st) { return std::holds_alternative<ro::motion_call>(st); });
   const auto& layout = calls ? layout_for(s, o) : rcb4::hth4_2_2;
-  const auto period = board_period(s);
-  const auto c = ro::to_program(d, robot, layout, period, rescale);
-  if (!ro::ok(c)) throw usage_error(fmt::format("{}: {} (nothing was sent)", file, std::get<ro::problem>(c).message));
-  const auto& cm = std::get<ro::compiled_motion>(c);
+  session_link link(s, g.json);
+  sv::host_play play(link, robot, layout, board_period(s), d, file, rescale,
+                     std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)));
   if (!g.json)
-    for (const auto& note : cm.notes) fmt::print(stderr, "note: {}\n", note);
-  if (const auto st = s.run(rcb4::ops::read_motion_state(layout)); st.running && st.motion)
-    throw failure(
-        exit_board,
-        fmt::format("motion {} is running on the board: it would fight the poses, so nothing was sent", *st.motion),
-        "rcb4 motion wait, or rcb4 motion stop");
-  // Every servo a pose moves needs a slot: the board ignores one it has none for.
-  const auto table = s.run(rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
-  const auto slots = rcb4::ops::parse_allocation_table(table);
-  if (!slots) throw rcb4::transport::system_error(slots.error());
-  for (const auto& st : cm.program.steps)
-    if (const auto* p = std::get_if<mo::pose>(&st))
-      for (const auto& e : p->targets)
-        if (std::none_of(slots->begin(), slots->end(), [&](const auto& k) { return k.ics == e.ics; })) {
-          const auto* j = robot.on(e.ics);
-          throw failure(exit_board,
-                        fmt::format("{} (ICS {}) has no slot on the board: its poses would not move it, so nothing "
-                                    "was sent",
-                                    j ? j->name : "a servo", e.ics.value()),
-                        "rcb4 scan shows the board's slots");
-        }
-  {
-    // Its calls checked as a push checks them (the host plays the poses; the board runs each call).
-    const auto code = mo::assemble(cm.program, mo::slot{rcb4::rom_address{}, 0x40000});
-    if (mo::ok(code)) {
-      const auto& bytes = std::get<std::vector<std::uint8_t>>(code);
-      session_link link(s, g.json);
-      sv::check_calls(link, layout, mo::disassemble(bytes, mo::slot{rcb4::rom_address{}, 0x40000}), &cm.program,
-                      d.where, "sent");
-    }
-  }
-  mo::player pl(cm.program);
-  if (!pl.error().empty()) throw usage_error(fmt::format("{}: {}", file, pl.error()));
-  const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period));
+    for (const auto& note : play.notes()) fmt::print(stderr, "note: {}\n", note);
   const bool tty = ::isatty(STDERR_FILENO) && !g.json;
   signal_catcher catcher;
   const auto start = std::chrono::steady_clock::now();
-  auto ready = start;  // when the board has finished the last pose: the next step comes then
+  const auto elapsed = [&] {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
+  };
   const auto seconds = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   bool stopped = false;
-  for (auto a = pl.next(); !std::holds_alternative<mo::finished>(a); a = pl.next()) {
-    if (!wait_until(ready)) {
+  for (auto next = play.advance(elapsed()); next; next = play.advance(elapsed())) {
+    if (tty) fmt::print(stderr, "\r  step {}  pose {}  {:5.1f} s ", play.step(), play.poses(), seconds());
+    if (!wait_until(start + *next)) {
+      play.stop();
       stopped = true;
       break;
     }
-    if (const auto* snd = std::get_if<mo::send>(&a)) {
-      s.run(rcb4::ops::detail::ack_sequence({snd->cmd}));
-      ready = std::max(ready, std::chrono::steady_clock::now()) + snd->frames * frame;
-      if (tty) fmt::print(stderr, "\r  step {}  pose {}  {:5.1f} s ", pl.step(), pl.poses(), seconds());
-    } else if (const auto* r = std::get_if<mo::read_value>(&a)) {
-      const auto v = s.run(rcb4::ops::read_memory(memory::ram, r->address.value(), r->size));
-      pl.value(static_cast<std::uint16_t>(v[0] | (r->size > 1 ? v[1] << 8 : 0)));
-    } else if (const auto* k = std::get_if<mo::play_code>(&a)) {
-      const std::uint32_t at = k->address.value(), base = layout.motion_base.value();
-      const auto n =
-          at >= base && (at - base) % layout.slot_size == 0 && (at - base) / layout.slot_size < layout.motion_count
-              ? std::optional<unsigned>((at - base) / layout.slot_size + 1)
-              : std::nullopt;
-      if (!n)
-        throw failure(exit_usage,
-                      fmt::format("{}: step {} calls 0x{:06X}, which starts no motion slot ({} layout): from the host "
-                                  "only whole motions are played",
-                                  file, pl.step(), k->address.value(), layout.name));
-      s.run(rcb4::ops::play_motion(*n, layout));
-      // Its end, polled as the board refreshes the state (50 ms), Ctrl-C and --timeout looked at
-      // between polls: either stops the motion on the board too.
-      const auto until =
-          std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000));
-      for (;;) {
-        const auto st = s.run(rcb4::ops::read_motion_state(layout));
-        if (!st.running) break;
-        if (std::chrono::steady_clock::now() >= until) {
-          s.run(rcb4::ops::stop_motion{});
-          throw failure(exit_timeout,
-                        fmt::format("{}: motion {}, called at step {}, still ran after {:g} s: stopped", file, *n,
-                                    pl.step(), o.timeout_s),
-                        "a motion that loops for ever ends only when it is stopped; --wait --timeout S waits longer");
-        }
-        if (!wait_until(std::chrono::steady_clock::now() + std::chrono::milliseconds(50))) {
-          s.run(rcb4::ops::stop_motion{});
-          stopped = true;
-          break;
-        }
-      }
-      if (stopped) break;
-      ready = std::chrono::steady_clock::now();
-    }
   }
-  if (!stopped) stopped = !wait_until(ready);
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
-  if (!pl.error().empty() && !stopped)
-    throw failure(exit_usage, fmt::format("{}: stopped at step {}: {}", file, pl.step(), pl.error()));
+  const auto period = play.period();
   if (stopped) {
     if (g.json)
-      emit(json{{"played", file}, {"interrupted", true}, {"poses", pl.poses()}, {"seconds", seconds()}});
+      emit(json{{"played", file}, {"interrupted", true}, {"poses", play.poses()}, {"seconds", seconds()}});
     else
       fmt::print(stderr,
                  "interrupted at step {} after {} ({:.1f} s): the servos stay where the last pose took them{}\n",
-                 pl.step(), plural(pl.poses(), "pose"), seconds(),
-                 pl.calls() ? " (a ROM motion it called was stopped: rcb4 motion play N starts afresh)" : "");
+                 play.step(), plural(play.poses(), "pose"), seconds(),
+                 play.calls() ? " (a ROM motion it called was stopped: rcb4 motion play N starts afresh)" : "");
     return exit_interrupted;
   }
   if (g.json)
     emit(json{{"played", file},
               {"interrupted", false},
-              {"poses", pl.poses()},
-              {"calls", pl.calls()},
+              {"poses", play.poses()},
+              {"calls", play.calls()},
               {"seconds", std::round(seconds() * 100) / 100},
               {"period_ms", rcb4::milliseconds(period)},
-              {"notes", cm.notes}});
+              {"notes", play.notes()}});
   else
     fmt::print("played {} from the host: {}{} in {:.2f} s ({} ms frames; nothing written to ROM)\n", file,
-               plural(pl.poses(), "pose"), pl.calls() ? ", " + plural(pl.calls(), "ROM motion") : "", seconds(),
+               plural(play.poses(), "pose"), play.calls() ? ", " + plural(play.calls(), "ROM motion") : "", seconds(),
                rcb4::milliseconds(period));
   return exit_ok;
 }

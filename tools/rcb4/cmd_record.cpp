@@ -5,7 +5,7 @@
 #include "app.hpp"
 
 #include <rcb4/robot/motion_file.hpp>
-#include <rcb4/robot/record.hpp>
+#include <rcb4/robot/services/record.hpp>
 
 #include <poll.h>
 #include <unistd.h>
@@ -20,6 +20,7 @@ namespace cli {
 namespace {
 
 namespace ro = rcb4::robot;
+namespace sv = rcb4::robot::services;
 
 struct record_options {
   std::string file;
@@ -33,7 +34,7 @@ struct record_options {
 /** True when Enter came on a terminal's stdin within @p wait; never reads a stdin that is not a terminal. */
 bool enter_within(std::chrono::milliseconds wait) {
   if (!::isatty(STDIN_FILENO)) {
-    std::this_thread::sleep_for(wait);
+    std::this_thread::sleep_for(wait);  // the tool's own pacing: stdin is not a terminal to poll
     return false;
   }
   pollfd p{STDIN_FILENO, POLLIN, 0};
@@ -55,121 +56,76 @@ int record(session& s, const record_options& o, const globals& g) {
     if (!existed) std::filesystem::remove(o.file);
   }
   const auto& m = robot_of(g);
-  const auto js = joints_of(m, o.joints);
-  const auto map = locate(s, m, js);
-  const auto period = s.run(rcb4::ops::read_config{}).period;
-  if (const auto st = s.run(rcb4::ops::read_motion_state{}); st.running && st.motion)
-    throw failure(exit_board, fmt::format("motion {} is running: the robot is not yours to move", *st.motion),
-                  "rcb4 motion wait, or rcb4 motion stop");
-  // Every joint must answer before anything is freed: a silent servo would record as nothing.
-  const auto angles = [&](std::vector<double>& out) {
-    const auto rs = read_all(s, map, ro::fields::positions);
-    out.clear();
-    for (const auto* j : js)
-      for (const auto& r : rs)
-        if (r.j == j) {
-          const auto d = r.degrees();
-          if (!d)
-            throw failure(exit_board,
-                          fmt::format("{} reads position {}: its servo does not answer", j->name, r.position),
-                          "rcb4 scan shows which servos answer; --joints leaves it out");
-          out.push_back(*d);
-        }
-  };
-  std::vector<double> sample;
-  angles(sample);
-  rcb4::servo_mask mask;
-  for (const auto* j : js) mask.insert(j->ics);
+  session_link link(s, g.json);
   signal_catcher catcher;
-  if (o.free) s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::free, mask));
-  // Whatever happens from here, joints freed are held again where they are.
-  struct hold_again {
-    session& s;
-    rcb4::servo_mask mask;
-    bool on;
-    ~hold_again() {
-      if (!on) return;
-      try {
-        s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
-      } catch (...) {  // the failure that brought us here is the one to report
-      }
-    }
-  } guard{s, mask, o.free};
+  // Checked first (no motion runs, every joint answers), then the joints freed when asked.
+  sv::recording rec(link, m, joints_of(m, o.joints),
+                    {.threshold = o.threshold,
+                     .free = o.free,
+                     .lead_in = std::chrono::milliseconds(1000),
+                     .cost = rcb4::ops::link_cost::at(s.baud(), std::chrono::milliseconds(1))});
+  const auto joints = o.joints.empty() ? m.joints().size() : joints_of(m, o.joints).size();
   if (!g.json)
-    fmt::print(stderr, "recording {} every {} ms{}: move the robot by hand; {}\n", plural(js.size(), "joint"),
-               o.every_ms, o.free ? " (free)" : "",
+    fmt::print(stderr, "recording {} every {} ms{}: move the robot by hand; {}\n", plural(joints, "joint"), o.every_ms,
+               o.free ? " (free)" : "",
                o.for_s > 0 ? fmt::format("stops after {:g} s (or Enter, Ctrl-C)", o.for_s)
                            : std::string(::isatty(STDIN_FILENO) ? "Enter or Ctrl-C stops" : "Ctrl-C stops"));
-  ro::recorder rec(js, o.threshold, period);
   const auto start = std::chrono::steady_clock::now();
   const auto every = std::chrono::milliseconds(o.every_ms);
   const bool tty = ::isatty(STDERR_FILENO) && !g.json;
   std::exception_ptr lost;
   for (auto next = start;;) {
     const auto now = std::chrono::steady_clock::now();
-    rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(now - start), sample);
+    try {
+      rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(now - start));
+    } catch (...) {  // the board went away: what was recorded is kept, then the failure is reported
+      lost = std::current_exception();
+      break;
+    }
     if (tty)
       fmt::print(stderr, "\r  {:5.1f} s  {} samples  {} poses ", std::chrono::duration<double>(now - start).count(),
-                 rec.samples(), rec.poses().size());
+                 rec.poses().samples(), rec.poses().poses().size());
     if (o.for_s > 0 && now - start >= std::chrono::duration<double>(o.for_s)) break;
     next += every;
     const auto wait = std::chrono::duration_cast<std::chrono::milliseconds>(next - std::chrono::steady_clock::now());
     if (signal_catcher::caught() || enter_within(std::max(wait, std::chrono::milliseconds(0))) ||
         signal_catcher::caught())
       break;
-    try {
-      angles(sample);
-    } catch (...) {  // the board went away: what was recorded is kept, then the failure is reported
-      lost = std::current_exception();
-      break;
-    }
   }
-  rec.finish();
   if (tty) fmt::print(stderr, "\r{:60}\r", "");
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  // A lost board: the guard still tries to hold the joints on the way out, and fails quietly.
-  if (o.free && !lost) {
-    guard.on = false;
-    s.run(rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, mask));
-  }
-  ro::motion_document d;
-  d.robot = m.name();
-  d.period = period;
-  for (const auto& p : rec.poses()) {
-    ro::motion_pose mp;
-    for (std::size_t i = 0; i < js.size(); ++i) mp.targets.push_back({js[i]->name, p.degrees[i], std::nullopt});
-    mp.time = p.time;
-    d.steps.emplace_back(std::move(mp));
-  }
-  d.steps.emplace_back(rcb4::motion::end{});
+  // A lost board: the joints are not held again (the recording tries once more as it goes, quietly).
+  const auto r = rec.finish(lost != nullptr);
+  if (r.document.steps.size() < 2) std::rethrow_exception(lost);  // not even the first sample
   try {
-    ro::save_motion(o.file, d,
+    ro::save_motion(o.file, r.document,
                     fmt::format("recorded by rcb4 motion record: {} samples every {} ms over {:.1f} s, kept where the "
                                 "movement left a straight line by more than {:g} degrees\nthe first pose takes {} ms "
                                 "from wherever the robot is when it plays",
-                                rec.samples(), o.every_ms, seconds, o.threshold, rec.poses().front().time.count()));
+                                r.samples, o.every_ms, seconds, o.threshold, rec.poses().poses().front().time.count()));
   } catch (const ro::profile_error& e) {
     throw failure(exit_io, e.what());
   }
+  const auto poses = r.document.steps.size() - 1;
   if (lost) {
     fmt::print(stderr, "rcb4 motion record: the {} recorded before the board stopped answering are in {}\n",
-               plural(rec.poses().size(), "pose"), o.file);
+               plural(poses, "pose"), o.file);
     std::rethrow_exception(lost);
   }
-  if (rec.clamped() && !g.json)
-    fmt::print(stderr, "note: {} angles were beyond a joint's limit and were recorded at the limit\n", rec.clamped());
+  if (r.clamped && !g.json)
+    fmt::print(stderr, "note: {} angles were beyond a joint's limit and were recorded at the limit\n", r.clamped);
   if (g.json)
     emit(json{{"file", o.file},
-              {"samples", rec.samples()},
-              {"poses", rec.poses().size()},
+              {"samples", r.samples},
+              {"poses", poses},
               {"seconds", std::round(seconds * 10) / 10},
-              {"period_ms", rcb4::milliseconds(period)},
-              {"clamped", rec.clamped()},
-              {"held", o.free}});
+              {"period_ms", rcb4::milliseconds(r.document.period)},
+              {"clamped", r.clamped},
+              {"held", r.held}});
   else
     fmt::print(
         "recorded {} from {} over {:.1f} s -> {}{} (rcb4 motion play {} replays it; motion push {} N stores it)\n",
-        plural(rec.poses().size(), "pose"), plural(rec.samples(), "sample"), seconds, o.file,
+        plural(poses, "pose"), plural(r.samples, "sample"), seconds, o.file,
         o.free ? " (the joints hold where they are)" : "", o.file, o.file);
   return exit_ok;
 }

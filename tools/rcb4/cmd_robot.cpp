@@ -4,6 +4,7 @@
 #include "app.hpp"
 
 #include <rcb4/robot/services/moves.hpp>
+#include <rcb4/robot/services/trims.hpp>
 
 #include <cerrno>
 #include <cmath>
@@ -461,16 +462,29 @@ void add_trim(CLI::App& app, context& ctx) {
       const auto& m = robot_of(ctx.g);
       const auto js = joints_of(m, *names);
       session s(ctx.g);
-      const auto map = locate(s, m, js);
-      const auto rs = read_all(s, map, robot::fields::state);
+      session_link link(s, ctx.g.json);
+      const auto trims = rcb4::robot::services::read_trims(link, m, js);
+      std::vector<std::string> missing;
+      for (const auto& t : trims)
+        if (!t.allocated) missing.push_back(fmt::format("{} (ICS {})", t.j->name, t.j->ics.value()));
+      if (!missing.empty())
+        throw failure(
+            exit_board, fmt::format("the board has no servo allocated for {}", fmt::join(missing, ", ")),
+            fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
       json list = json::array();
-      for (const auto& r : rs) {
-        if (std::find(js.begin(), js.end(), r.j) == js.end()) continue;
-        const double d = robot::trim_degrees(*r.j, r.trim);
+      for (const auto& t : trims) {
+        const auto rom = t.rom_degrees();
         if (ctx.g.json)
-          list.push_back({{"name", r.j->name}, {"degrees", std::round(d * 100) / 100}, {"counts", r.trim}});
+          list.push_back({{"name", t.j->name},
+                          {"degrees", std::round(t.degrees() * 100) / 100},
+                          {"counts", t.ram},
+                          {"rom_degrees", rom ? json(std::round(*rom * 100) / 100) : json(nullptr)},
+                          {"rom_counts", t.rom ? json(*t.rom) : json(nullptr)}});
         else
-          fmt::print("{:<22} {:+6.2f} deg  ({:+d} counts)\n", r.j->name, d, r.trim);
+          fmt::print("{:<22} {:+6.2f} deg  ({:+d} counts){}\n", t.j->name, t.degrees(), t.ram,
+                     !t.rom            ? std::string("  ROM: none")
+                     : *t.rom == t.ram ? std::string()
+                                       : fmt::format("  ROM {:+.2f} deg ({:+d}): power-on loads that", *rom, *t.rom));
       }
       if (ctx.g.json) emit(list);
       return exit_ok;
@@ -489,40 +503,15 @@ void add_trim(CLI::App& app, context& ctx) {
     auto items = targets_of(so->items);
     ctx.action = [&ctx, so, items] {
       const auto& m = robot_of(ctx.g);
-      std::vector<robot::joint_trim> trims;
+      std::vector<std::pair<std::string, double>> trims;
       for (const auto& t : items) {
         if (t.time) throw usage_error(fmt::format("{}: a trim has no duration (@MS)", t.joint));
-        const auto* j = m.find(t.joint);
-        if (!j) throw usage_error(fmt::format("no joint is called '{}' (see rcb4 joint list)", t.joint));
-        if (std::any_of(trims.begin(), trims.end(), [&](const robot::joint_trim& x) { return x.j == j; }))
-          throw usage_error(fmt::format("{} is given twice", t.joint));
-        auto tr = robot::trim_of(*j, t.degrees);
-        if (!robot::ok(tr)) throw usage_error(std::get<robot::problem>(tr).message);
-        trims.push_back(std::get<robot::joint_trim>(tr));
+        trims.emplace_back(t.joint, t.degrees);
       }
       session s(ctx.g);
-      robot::write_trims op(trims, so->persist);
-      rcb4::transport::error_code ec;
-      s.run_steps(op, ec, [] {});
-      if (ec && op.in_ram() > 0) {
-        // Some writes landed before the failure: say which, so nobody believes nothing changed.
-        const auto first_trims = [&](std::size_t n) {
-          std::vector<std::string> out;
-          for (std::size_t i = 0; i < n; ++i) out.push_back(fmt::format("{} {:+d}", trims[i].j->name, trims[i].counts));
-          return out.empty() ? std::string("none") : fmt::format("{}", fmt::join(out, ", "));
-        };
-        throw explain(ec, fmt::format("{} (already written: RAM {}{})", ec.message(), first_trims(op.in_ram()),
-                                      so->persist ? "; ROM " + first_trims(op.in_rom()) : std::string()));
-      }
-      if (ec == rcb4::errc::servo_not_allocated && op.unallocated()) {
-        const auto* j = op.unallocated();
-        throw failure(
-            exit_board,
-            fmt::format("the board has no servo allocated for {} (ICS {}): nothing written", j->name, j->ics.value()),
-            fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
-      }
-      if (ec) throw rcb4::transport::system_error(ec);
-      const auto& done = op.value();
+      session_link link(s, ctx.g.json);
+      const auto report = rcb4::robot::services::set_trims(link, m, trims, so->persist);
+      const auto& done = report.written;
       json list = json::array();
       for (const auto& t : done) {
         if (ctx.g.json)

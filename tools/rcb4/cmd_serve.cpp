@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 namespace cli {
 namespace {
@@ -23,7 +24,8 @@ struct serve_options {
   long long servos = -1;
   std::vector<int> silent;
   int period_ms = 0;
-  std::string turn;  // ICS:MS, a hand turning a servo on a schedule
+  std::string turn;   // ICS:MS, a hand turning a servo on a schedule
+  bool hand = false;  // a hand that turns freed joints as lines on stdin say (JOINT DEGREES)
   rcb4::transport::serve_options serve;
   rcb4::board::options board;
 };
@@ -161,10 +163,51 @@ int serve(serve_options& o, const globals& g) {
     });
   };
   if (turn) turn_next();
+
+  // --hand: "JOINT DEGREES" per line on stdin turns that joint by hand when its servo is free (a
+  // person posing the robot, for capture, record and teaching tests); each line is answered.
+  boost::asio::posix::stream_descriptor input(io);
+  boost::asio::streambuf lines;
+  std::function<void()> read_line = [&] {
+    boost::asio::async_read_until(input, lines, '\n', [&](const boost::system::error_code& ec, std::size_t n) {
+      if (ec) return;  // end of input: the board goes on being served
+      std::string line(boost::asio::buffers_begin(lines.data()),
+                       boost::asio::buffers_begin(lines.data()) + static_cast<std::ptrdiff_t>(n));
+      lines.consume(n);
+      std::istringstream words(line);
+      std::string name;
+      double deg = 0;
+      const auto& m = robot_of(g);
+      const auto* j = (words >> name >> deg) ? m.find(name) : nullptr;
+      if (!j) {
+        fmt::print(stderr, "hand: '{}': expected JOINT DEGREES with a joint of {}\n", line.substr(0, line.find('\n')),
+                   m.name());
+      } else if (const auto block = board.block_of(j->ics); !block) {
+        fmt::print(stderr, "hand: {}: the board has no servo for it\n", name);
+      } else if (board.ram16(*block + servo_block::target.offset) != 0x8000) {
+        fmt::print(stderr, "hand: {}: its servo holds its position: free it first\n", name);
+      } else {
+        const double d = std::clamp(deg, j->lower, j->upper);
+        board.turn_by_hand(j->ics, std::get<rcb4::servo_position>(rcb4::robot::to_position(*j, d)).value());
+        if (g.json)
+          emit(json{{"hand", name}, {"degrees", d}});
+        else
+          fmt::print("hand turned {} to {:g}\n", name, d);
+        std::fflush(stdout);
+      }
+      read_line();
+    });
+  };
+  if (o.hand) {
+    input.assign(::dup(STDIN_FILENO));
+    read_line();
+  }
   boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
   signals.async_wait([&](const boost::system::error_code&, int) {
     saver.cancel();
     hand.cancel();
+    boost::system::error_code ignored;
+    if (input.is_open()) input.close(ignored);
     server->stop();
   });
   io.run();
@@ -214,6 +257,9 @@ void add_serve_command(CLI::App& app, context& ctx) {
                   "turn servo ICS by hand every MS ms, 500 counts one way then back (a free servo stays where it is "
                   "turned), each turn printed with its CLOCK_MONOTONIC time: for latency measurements")
       ->type_name("ICS:MS");
+  cmd->add_flag("--hand", o->hand,
+                "a hand for scripts: each line \"JOINT DEGREES\" on stdin turns that joint (of --robot) when its "
+                "servo is free, as a person posing the robot; each line is answered on stdout (or why not on stderr)");
   cmd->footer(
       "Serves an emulated RCB-4HV wired as the robot --robot names (default: a KHR-3HV, 20 servos,\n"
       "three demo motions) until SIGINT/SIGTERM. The first line on stdout is where to connect:\n"

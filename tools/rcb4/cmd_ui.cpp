@@ -10,7 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <thread>
 
 namespace cli {
@@ -20,6 +22,7 @@ struct ui_options {
   std::string listen = "127.0.0.1:8080";
   std::string token;
   std::string poses = "poses";
+  std::string three = "/usr/share/javascript/three";  ///< Debian's libjs-three
   std::string layout = "auto";
   double speed = 90;
 };
@@ -79,6 +82,23 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
   for (char c : so.token)
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
       throw usage_error("--token: use letters, digits, - and _ (it goes in a URL and a cookie)");
+
+  // three.js for the 3D view, served from Debian's copy (libjs-three) as Debian wants JavaScript
+  // libraries shared, not embedded: read once here, so nothing is read from disk while serving.
+  for (const auto& [url, file] :
+       {std::pair{"/vendor/three/build/three.module.js", "build/three.module.js"},
+        std::pair{"/vendor/three/examples/jsm/controls/OrbitControls.js", "examples/jsm/controls/OrbitControls.js"}}) {
+    std::ifstream in(std::filesystem::path(o.three) / file, std::ios::binary);
+    if (!in) {
+      fmt::print(stderr, "rcb4 ui: no {} in {} (apt install libjs-three): the page works without its 3D view\n", file,
+                 o.three);
+      so.vendor.clear();
+      break;
+    }
+    std::ostringstream body;
+    body << in.rdbuf();
+    so.vendor.push_back({url, "text/javascript; charset=utf-8", body.str()});
+  }
 
   boost::asio::io_context io;
   std::optional<ui::web_server> server;
@@ -164,6 +184,9 @@ void add_ui_command(CLI::App& app, context& ctx) {
                   "the secret every request must carry (?token=, then a cookie); generated and printed in the URL "
                   "when --listen is not loopback and none is given")
       ->type_name("T");
+  cmd->add_option("--three", o->three,
+                  "where three.js is (Debian's libjs-three: /usr/share/javascript/three), for the 3D view")
+      ->type_name("DIR");
   cmd->add_option("--poses", o->poses, "where poses are saved and found (NAME.yaml; default ./poses)")
       ->type_name("DIR");
   cmd->add_option("--speed", o->speed, "the fastest a page may move a joint, degrees per second (default 90)")

@@ -161,4 +161,44 @@ class player {
   std::string error_;
 };
 
+/** How long a program plays, as the board runs it (play_time). */
+struct play_estimate {
+  unsigned long long frames = 0;  ///< interpolation frames of its poses, every loop counted
+  bool endless = false;           ///< it goes round for ever (or longer than play_time looks)
+  bool reads = false;             ///< a branch read RAM (buttons, AD, ...): taken as 0, nothing pressed
+  std::size_t calls = 0;          ///< ROM motions it calls: their time is not counted
+  std::string error;              ///< why it cannot be played (player::error), or empty
+};
+
+/**
+ * The frames @p p plays as the board runs it: counters and loops counted, every RAM value a
+ * branch reads taken as 0 (no button held, AD and RAM at 0), calls not followed. A program that
+ * is still going after @p longest frames is endless (the default: an hour at 10 ms).
+ */
+inline play_estimate play_time(const program& p, unsigned long long longest = 360000) {
+  play_estimate e;
+  player pl(p);
+  for (auto a = pl.next(); !std::holds_alternative<finished>(a); a = pl.next()) {
+    if (const auto* s = std::get_if<send>(&a)) {
+      e.frames += s->frames;
+      if (e.frames > longest || pl.poses() > 1000000) {
+        e.endless = true;
+        return e;
+      }
+    } else if (std::holds_alternative<read_value>(a)) {
+      e.reads = true;
+      pl.value(0);
+    } else if (std::holds_alternative<play_code>(a)) {
+      ++e.calls;
+    }
+  }
+  e.error = pl.error();
+  // A loop without poses spins on the player's step guard: a program that never ends.
+  if (!e.error.empty() && e.error.find("spin for ever") != std::string::npos) {
+    e.endless = true;
+    e.error.clear();
+  }
+  return e;
+}
+
 }  // namespace rcb4::motion

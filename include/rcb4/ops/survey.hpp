@@ -50,12 +50,13 @@ class scan_slots {
 
 /** A used motion slot. */
 struct motion_slot {
-  unsigned number = 0;        ///< 1-based
-  std::uint32_t address = 0;  ///< its first byte in ROM
-  std::uint32_t size = 0;     ///< bytes up to and including the first RETURN (or the last valid frame)
-  unsigned frames = 0;        ///< frames walked
-  bool ends = false;          ///< true when a RETURN was found; false: the walk met a byte that starts no frame
-  bool readable = true;       ///< false: the first frame fails its checksum (another ROM layout?)
+  unsigned number = 0;             ///< 1-based
+  std::uint32_t address = 0;       ///< its first byte in ROM
+  std::uint32_t size = 0;          ///< bytes up to and including the first RETURN (or the last valid frame)
+  unsigned frames = 0;             ///< frames walked
+  bool ends = false;               ///< true when a RETURN was found; false: the walk met a byte that starts no frame
+  bool readable = true;            ///< false: the first frame fails its checksum (another ROM layout?)
+  std::vector<std::uint8_t> code;  ///< its bytes up to and including the first RETURN (size bytes)
 };
 
 /** Lists the used motion slots of @p layout (see the file comment). */
@@ -80,7 +81,7 @@ class list_motions {
       if (size >= 3 && size <= max_request_size) {
         walking_ = true;
         data_.clear();
-        current_ = {slot_, slot_base(), 0, 0, false, true};
+        current_ = {slot_, slot_base(), 0, 0, false, true, {}};
       } else {
         ++slot_;
       }
@@ -102,6 +103,7 @@ class list_motions {
  private:
   std::uint32_t slot_base() const { return layout_.motion_base.value() + (slot_ - 1) * layout_.slot_size; }
   void finish() {
+    current_.code.assign(data_.begin(), data_.begin() + std::min<std::ptrdiff_t>(current_.size, std::ssize(data_)));
     slots_.push_back(current_);
     walking_ = false;
     ++slot_;

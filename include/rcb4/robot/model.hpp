@@ -13,6 +13,7 @@
 #pragma once
 
 #include <rcb4/ops/servos.hpp>
+#include <rcb4/robot/kinematics.hpp>
 #include <rcb4/values.hpp>
 
 #include <algorithm>
@@ -149,12 +150,23 @@ class model {
   std::string_view motion(unsigned slot) const noexcept;
   /** Every joint's slot. */
   servo_mask mask() const noexcept;
+  /** The robot's body (links, where each joint sits), when the profile describes it; else nullptr. */
+  const kinematics* body() const noexcept { return body_ ? &*body_ : nullptr; }
+  /** Gives the robot the body @p k, checked against its joints (check_body); its problem, and no body, if unsound. */
+  std::optional<body_problem> attach_body(kinematics k) {
+    std::vector<std::string> names;
+    for (const auto& j : joints_) names.push_back(j.name);
+    if (auto p = check_body(k, names)) return p;
+    body_ = std::move(k);
+    return std::nullopt;
+  }
 
  private:
   std::string name_;
   std::vector<joint> joints_;
   std::vector<group> groups_;
   std::vector<motion_name> motions_;
+  std::optional<kinematics> body_;
 };
 
 // ---------------------------------------------------------------------------------------------

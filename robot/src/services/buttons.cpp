@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/ops/layout.hpp>
 #include <rcb4/ops/memory.hpp>
+#include <rcb4/ops/system.hpp>
 #include <rcb4/robot/services/buttons.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
 
@@ -172,6 +173,13 @@ press_report press(link& l, const rom_layout& layout, std::uint16_t buttons, boo
                     fmt::format("rcb4 motion buttons clear {}", mo::buttons_text(buttons)));
     }
   }
+  // The board compares the table only while its ROM program runs (a ROM restore or a stop leaves it off).
+  if (r.entry && !run(l, rcb4::ops::read_config{}).rom_program)
+    throw refused(refusal_kind::board,
+                  fmt::format("the ROM program is off (a ROM restore or a stop leaves it off): a press of {} would "
+                              "play nothing until it runs, so nothing was pressed",
+                              mo::buttons_text(buttons)),
+                  "rcb4 motion resume lets it run");
   write(l, memory::ram, krr::buttons.value(), krr::encode_buttons(buttons));
   if (!r.entry) {  // held as a receiver would hold them: only a motion's button test sees them
     r.state = run(l, rcb4::ops::read_motion_state(layout));

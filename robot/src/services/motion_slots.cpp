@@ -4,6 +4,7 @@
 #include <rcb4/ops/motion.hpp>
 #include <rcb4/ops/system.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
 
 #include <fmt/format.h>
 
@@ -183,6 +184,15 @@ void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> 
 
 }  // namespace
 
+std::string play_time_text(const motion::play_estimate& e, output_period period) {
+  if (!e.error.empty()) return "cannot be played: " + e.error;
+  if (e.endless) return "plays until stopped: it goes round for ever";
+  std::string t = fmt::format("plays {:.2f} s", static_cast<double>(e.frames) * rcb4::milliseconds(period) / 1000.0);
+  if (e.calls) t += fmt::format(" and {} call{} of other motions", e.calls, e.calls == 1 ? "" : "s");
+  if (e.reads) t += ", no button held";
+  return t;
+}
+
 std::string file_stamp() {
   char stamp[32];
   const std::time_t t = std::time(nullptr);
@@ -290,6 +300,35 @@ void check_calls(link& l, const rom_layout& layout, const mo::listing& code, con
                               "stack, so the board would stop (nothing was {})",
                               *d - 1, chain_text(layout, chain), *d, stack_depth, done),
                   "call fewer motions within each other");
+  // The motions that call this slot nest deeper by what it now adds: when it is deeper than the
+  // code it replaces, every used slot is looked at for a caller whose chain would overflow.
+  if (!slot_number(layout, self)) return;  // played from the host: nothing in ROM calls it
+  if (*d <= 1) return;                     // it calls nothing: no caller can nest deeper than before
+  rom_code before(l, layout, nullptr);
+  std::vector<std::uint32_t> unused;
+  const auto was = before.depth(self, unused);
+  if (was && *d <= *was) return;
+  for (unsigned k = 1; k <= layout.motion_count; ++k) {
+    const std::uint32_t a = layout.motion_base.value() + (k - 1) * layout.slot_size;
+    if (a == self) continue;
+    l.progress("looking for motions that call it", k, layout.motion_count);
+    if (run(l, rcb4::ops::read_memory(rcb4::ops::memory::rom, a, 1))[0] == 0xFF) continue;  // empty
+    if (!rom.reaches(a, self)) continue;
+    std::vector<std::uint32_t> via;
+    const auto caller = rom.depth(a, via);
+    if (!caller)
+      throw refused(refusal_kind::board,
+                    fmt::format("{} calls it, and with the new code the calls come back round ({}): the board's "
+                                "{}-deep call stack would overflow (nothing was {})",
+                                name_of(layout, a), chain_text(layout, via), stack_depth, done),
+                    "a motion that repeats itself loops with goto, not call");
+    if (*caller > stack_depth)
+      throw refused(refusal_kind::board,
+                    fmt::format("{} calls it, and with the new code its calls nest {} deep ({}): played, it needs {} "
+                                "levels of the board's {}-deep call stack, so the board would stop (nothing was {})",
+                                name_of(layout, a), *caller - 1, chain_text(layout, via), *caller, stack_depth, done),
+                    "call fewer motions within each other");
+  }
 }
 
 void require_writable(link& l, const rom_layout& layout, unsigned n, std::span<const std::uint8_t> old,
@@ -377,6 +416,16 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
       throw refused(refusal_kind::usage,
                     fmt::format("{}: {} (nothing was written)", src.name, std::get<problem>(c).message));
     const auto& cm = std::get<compiled_motion>(c);
+    // A call of its own slot is recursion, refused as any call loop is (the assembler refuses it
+    // too, but as a file's mistake: it is the board's stack that cannot take it).
+    for (std::size_t i = 0; i < cm.program.steps.size(); ++i)
+      if (const auto* call = std::get_if<mo::call_motion>(&cm.program.steps[i]); call && call->address == where.address)
+        throw refused(refusal_kind::board,
+                      fmt::format("step {}{} calls motion {}, itself: its calls come back round, every pass taking "
+                                  "another level of the board's {}-deep call stack until the board stops (nothing "
+                                  "was written)",
+                                  i + 1, i < d.where.size() ? fmt::format(" ({})", d.where[i]) : "", n, stack_depth),
+                      "a motion that repeats itself loops with goto, not call");
     auto b = mo::assemble(cm.program, where);
     if (!mo::ok(b))
       throw refused(refusal_kind::usage,
@@ -386,37 +435,56 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
     code = mo::disassemble(r.bytes, where);
     check_calls(l, layout, code, &cm.program, d.where, "written");
     std::size_t poses = 0;
-    unsigned frames = 0;
     for (const auto& st : cm.program.steps)
-      if (const auto* p = std::get_if<mo::pose>(&st)) ++poses, frames += p->time.value();
+      if (std::holds_alternative<mo::pose>(st)) ++poses;
     const auto steps = cm.program.steps.size();
-    r.summary = fmt::format("{} step{}, {} pose{} ({:.2f} s of moves)", steps, steps == 1 ? "" : "s", poses,
-                            poses == 1 ? "" : "s", frames * rcb4::milliseconds(cm.period) / 1000.0);
+    r.summary = fmt::format("{} step{}, {} pose{} ({})", steps, steps == 1 ? "" : "s", poses, poses == 1 ? "" : "s",
+                            play_time_text(mo::play_time(cm.program), cm.period));
   }
   if (dry_run) return r;
   const auto old = read_rom(l, r.address, where.size, fmt::format("backing up motion {}", n));
   require_writable(l, layout, n, old, "written");
   if (std::equal(r.bytes.begin(), r.bytes.end(), old.begin())) {
     r.unchanged = true;
-    return r;
+  } else {
+    r.backup = backup(n, old);
+    write_rom_checked(l, r.address, r.bytes, fmt::format("writing motion {}", n), n, r.backup);
   }
-  r.backup = backup(n, old);
-  write_rom_checked(l, r.address, r.bytes, fmt::format("writing motion {}", n), n, r.backup);
+  // A motion file names its slot (the board keeps no names): the name goes with the code, and a
+  // file without one leaves the slot unnamed. A backup's bytes keep whatever name the slot had.
+  if (src.document) {
+    r.name = src.document->name;
+    try {
+      set_slot_name(robot.name(), n, r.name);
+    } catch (const refused& e) {
+      r.notes.push_back(fmt::format("the slot's name was not kept: {}", e.what()));
+    }
+  }
   return r;
 }
 
-erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup) {
+erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup,
+                          const std::string& robot) {
   const auto where = slot_for(layout, n);
   erase_report r{n, where.address.value(), where.size, false, {}};
+  const auto forget = [&] {
+    if (robot.empty()) return;
+    try {
+      set_slot_name(robot, n, {});
+    } catch (const refused&) {  // an unreadable names file: the erase itself is done
+    }
+  };
   const auto old = read_rom(l, r.address, where.size, fmt::format("backing up motion {}", n));
   require_writable(l, layout, n, old, "erased");
   if (std::all_of(old.begin(), old.end(), [](std::uint8_t b) { return b == 0xFF; })) {
     r.unchanged = true;
+    forget();
     return r;
   }
   r.backup = backup(n, old);
   const std::vector<std::uint8_t> erased(where.size, 0xFF);
   write_rom_checked(l, r.address, erased, fmt::format("erasing motion {}", n), n, r.backup);
+  forget();
   return r;
 }
 
@@ -443,7 +511,12 @@ pull_report pull_motion(link& l, const model& robot, const rom_layout& layout, u
         fmt::format("rcb4 motion show {} lists it; rcb4 read rom 0x{:06X} {} saves its bytes", n, r.address, r.bytes));
   r.period = board_period(l);
   r.document = from_program(std::get<mo::program>(p), robot, layout, r.period);
-  r.document.name = std::string(robot.motion(n));
+  r.plays = play_time_text(mo::play_time(std::get<mo::program>(p)), r.period);
+  try {
+    r.document.name = slot_name(robot, n, load_slot_names(robot.name()));
+  } catch (const refused&) {  // an unreadable names file: the profile's name
+    r.document.name = std::string(robot.motion(n));
+  }
   // Checked as a push will check it: a pose beyond a limit pulls, but does not push back as it is.
   const auto again = to_program(r.document, robot, layout, r.period);
   if (!ok(again)) r.beyond = std::get<problem>(again).message;

@@ -108,7 +108,7 @@ TEST_CASE("ui messages: bad ones are refused with the reason", "[ui]") {
   CHECK(parse_failure(R"({"op":"move","joints":{"a":1,"a":2}})") == "a key is given twice");
   CHECK(parse_failure(R"({"op":"stop","id":"x"})") == "'id' must be a whole number");
   CHECK(parse_failure(R"({"op":"stop","x":[[[[1]]]]})") == "message nested too deeply");
-  CHECK(parse_failure(std::string(max_message_bytes + 1, ' ')).find("at most 16384") != std::string::npos);
+  CHECK(parse_failure(std::string(max_message_bytes + 1, ' ')).find("at most 65536") != std::string::npos);
 
   // The id survives a refused body, so the page can match the answer.
   auto r = parse_message(R"({"op":"motion_play","id":42,"slot":500})");
@@ -356,4 +356,44 @@ TEST_CASE("ui controller: after free, a move is timed from the measured angle", 
   const auto mv = c.due_move(t0 + 1s);
   REQUIRE(mv);
   CHECK(std::get<move_action>(mv->body).targets[0].time == 878ms);  // 79 degrees, not 1
+}
+
+TEST_CASE("ui studio messages: each op's fields checked and only the controlling page writes", "[ui]") {
+  // Fields checked before anything reaches the board loop.
+  CHECK(parse_failure(R"({"op":"motion_push","slot":10})") == "motion_push: 'text' is missing");
+  CHECK(parse_failure(R"({"op":"motion_push","slot":0,"text":"x"})") == "motion_push: slot 0 is outside 1..120");
+  CHECK(parse_failure(R"({"op":"motion_push","slot":3,"text":7})") ==
+        "motion_push: 'text' must be a motion file's text (YAML or JSON)");
+  CHECK(parse_failure(R"({"op":"motion_pull","slot":3,"force":true})").find("motion_pull: unknown key 'force'") == 0);
+  CHECK(parse_failure(R"({"op":"trim_set","joints":{"left_knee":"1"}})") ==
+        "trim_set: 'left_knee' must be a number of degrees");
+  CHECK(parse_failure(R"({"op":"button_press","buttons":"up","hold":1})") ==
+        "button_press: 'hold' must be true or false");
+  CHECK(parse_failure(R"({"op":"hand","joint":"left_knee"})") == "hand: 'degrees' is missing");
+  CHECK(parse_failure(R"({"op":"motion_check","text":")" + std::string(max_text_bytes + 1, 'x') + R"("})")
+            .find("longer than") != std::string::npos);
+  CHECK(parse_failure(R"({"op":"frobnicate"})").find("motion_push") != std::string::npos);  // the known ops listed
+
+  const auto m = two_joints();
+  controller c(m);
+  c.join(1);
+  c.join(2);
+  const auto t0 = clock::time_point{} + 1h;
+  // Reading: any page; the action carries the checked fields.
+  auto e = c.receive(2, R"({"op":"motion_pull","slot":7,"id":4})", t0);
+  REQUIRE(e.actions.size() == 1);
+  const auto& pull = std::get<studio_action>(e.actions[0].body);
+  CHECK(pull.op == "motion_pull");
+  CHECK(nlohmann::json::parse(pull.args) == nlohmann::json{{"slot", 7}});
+  // Writing: the watcher is refused, the controller heard.
+  e = c.receive(2, R"({"op":"motion_erase","slot":7,"id":5})", t0);
+  CHECK(e.actions.empty());
+  CHECK(last_json(e)["message"] == "this page only watches: take control first");
+  e = c.receive(1, R"({"op":"play_motion","text":"robot: TEST","id":6})", t0);
+  REQUIRE(e.actions.size() == 1);
+  CHECK(std::get<studio_action>(e.actions[0].body).op == "play_motion");
+  // A page that played a motion from the host and goes: it is stopped.
+  e = c.leave(1);
+  REQUIRE(e.actions.size() == 1);
+  CHECK(std::get<stop_action>(e.actions[0].body).motion);
 }

@@ -2,9 +2,12 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "board_loop.hpp"
 
+#include "studio_ops.hpp"
+
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/moves.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -42,7 +45,8 @@ struct refusal {
 
 class loop {
  public:
-  loop(session& s, const robot::model& m, hub& h, const loop_options& o) : s_(s), m_(m), h_(h), o_(o) {
+  loop(session& s, const robot::model& m, hub& h, const loop_options& o)
+      : s_(s), m_(m), h_(h), o_(o), studio_(s, m, o) {
     angles_.resize(m.joints().size());
     targets_.resize(m.joints().size());
     modes_.resize(m.joints().size(), "unknown");
@@ -58,13 +62,16 @@ class loop {
         carry_out(a);
       }
       if (h_.stopped()) return;
+      if (auto done = studio_.tick()) h_.tell(done->to, done->text);  // a motion played from the host
       poll();
       if (answering_ && !lists_sent) {  // after the first state: a page shows the robot at once
         refresh_lists();
         lists_sent = true;
       }
       const auto pause = answering_ ? o_.period : 500ms;  // a silent board is tried twice a second
-      if (!h_.wait_until(start + pause)) break;
+      // A motion played from the host wakes the loop when its next pose is due, not a poll later.
+      const auto wake = std::min(start + pause, studio_.due().value_or(start + pause));
+      if (!h_.wait_until(wake)) break;
     }
   }
 
@@ -210,7 +217,7 @@ class loop {
     j["poses"] = pose_names();
     json ms = json::array();
     for (const auto& v : motions_) {
-      const auto name = m_.motion(v.number);
+      const auto name = robot::services::slot_name(m_, v.number);
       ms.push_back({{"slot", v.number},
                     {"name", name.empty() ? json(nullptr) : json(std::string(name))},
                     {"frames", v.frames},
@@ -242,12 +249,24 @@ class loop {
             return "motion_stop";
           else if constexpr (std::is_same_v<B, motion_file_action>)
             return "motion_file";
+          else if constexpr (std::is_same_v<B, studio_action>)
+            return b.op;
           else
             return "refresh";
         },
         a.body);
     try {
-      json extra = std::visit([&](const auto& b) { return act(b); }, a.body);
+      json extra;
+      if (const auto* st = std::get_if<studio_action>(&a.body)) {
+        try {
+          extra = studio_.act(*st, a.from);
+        } catch (const studio_refusal& r) {
+          throw refusal{r.what()};
+        }
+        if (st->op == "motion_push" || st->op == "motion_erase") refresh_lists();
+      } else {
+        extra = std::visit([&](const auto& b) { return act(b); }, a.body);
+      }
       // Slider moves come without an id; they are answered only when they fail.
       if (a.id || !std::holds_alternative<move_action>(a.body))
         if (a.from) h_.tell(a.from, reply_text(a.id, op, extra.is_null() ? std::string() : text_of(extra)));
@@ -287,6 +306,7 @@ class loop {
   /** Moves @p targets (checked here again: nothing from a page is trusted). */
   json move(std::vector<robot::joint_target> targets) {
     refuse_during_motion();
+    if (studio_.playing()) throw refusal{"a motion plays from the host: it would overwrite the move (Stop it first)"};
     // A CONST frame carries 255 frames at most (protocol.md §5): 2.55 s on a 10 ms board. A longer
     // time (a page's, or the speed limit's) becomes the slowest move the board can make.
     for (auto& t : targets)
@@ -343,8 +363,15 @@ class loop {
     }
   }
 
+  json act(const studio_action&) { return nullptr; }  // carried out by carry_out, which knows the page
+
   json act(const stop_action& a) {
     json out;
+    // A motion played from the host stops first: its next pose must not follow the hold.
+    try {
+      studio_.stop();
+    } catch (const std::exception&) {  // the board may not answer: the hold below is tried anyway
+    }
     // The state is read now, not taken from the last poll: a motion started since must stop too.
     // Stopping it comes first (it would drive the joints again), then the hold.
     if (a.motion) {
@@ -484,7 +511,7 @@ class loop {
       throw refusal{fmt::format("motion {} is code a motion file cannot say: {} (rcb4 motion show {} lists it)", a.slot,
                                 std::get<rcb4::motion::failure>(p).message, a.slot)};
     auto d = robot::from_program(std::get<rcb4::motion::program>(p), m_, *o_.layout, period_);
-    d.name = std::string(m_.motion(a.slot));
+    d.name = robot::services::slot_name(m_, a.slot);
     const auto again = robot::to_program(d, m_, *o_.layout, period_);
     return json{{"slot", a.slot},
                 {"name", d.name},
@@ -508,12 +535,42 @@ class loop {
   bool answering_ = false;
   std::string error_;
   std::uint64_t seq_ = 0;
+  studio_ops studio_;
   std::uint64_t last_exchanges_ = 0;
   double rate_ = 0;
   clock::time_point last_rate_at_;
 };
 
 }  // namespace
+
+json body_json(const robot::model& m) {
+  const auto* k = m.body();
+  if (!k) return nullptr;
+  const auto v3 = [](const robot::vec3& v) { return json::array({v[0], v[1], v[2]}); };
+  json links = json::array();
+  for (const auto& l : k->links) {
+    json shapes = json::array();
+    for (const auto& s : l.shapes)
+      shapes.push_back({{"type", s.type == robot::shape::kind::box        ? "box"
+                                 : s.type == robot::shape::kind::cylinder ? "cylinder"
+                                                                          : "sphere"},
+                        {"size", v3(s.size)},
+                        {"xyz", v3(s.xyz)},
+                        {"rpy", v3(s.rpy)}});
+    links.push_back({{"name", l.name}, {"shapes", std::move(shapes)}});
+  }
+  json joints = json::array();
+  for (const auto& j : k->joints)
+    joints.push_back({{"name", j.name},
+                      {"fixed", j.fixed},
+                      {"parent", j.parent},
+                      {"child", j.child},
+                      {"xyz", v3(j.xyz)},
+                      {"rpy", v3(j.rpy)},
+                      {"axis", v3(j.axis)}});
+  return json{
+      {"root", k->root()->name}, {"links", std::move(links)}, {"joints", std::move(joints)}, {"source", k->source}};
+}
 
 void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) { loop(s, m, h, o).run(); }
 
@@ -537,6 +594,7 @@ std::string hello_text(const robot::model& m, const session& s, const loop_optio
   j["max_move_ms"] = max_move_ms;
   j["period_ms"] = o.period.count();
   j["version"] = RCB4_VERSION;
+  j["body"] = body_json(m);
   return text_of(j);
 }
 

@@ -167,8 +167,19 @@ void controller::handle(client_id c, const message& m, effects& e) {
     e.actions.push_back({c, m.id, motion_file_action{mf->slot}});
     return;
   }
+  if (const auto* st = std::get_if<studio_request>(&m.body); st && !st->writes) {  // reading: any page
+    e.actions.push_back({c, m.id, studio_action{st->op, st->args}});
+    return;
+  }
   if (controller_ != c) {
     refuse("this page only watches: take control first");
+    return;
+  }
+  if (const auto* st = std::get_if<studio_request>(&m.body)) {
+    // A motion played from the host or a button pressed is stopped when the page goes, as a ROM motion it started.
+    if (st->op == "play_motion" || st->op == "button_press") started_motion_ = true;
+    pending_.clear();  // a slider value still waiting would fight what the studio does
+    e.actions.push_back({c, m.id, studio_action{st->op, st->args}});
     return;
   }
   if (std::holds_alternative<release_control>(m.body)) {

@@ -80,12 +80,18 @@ struct motion_file_action {
   unsigned slot = 0;  ///< 1..120
 };
 
+/** A studio op (messages.hpp) for the board loop's studio part (studio_ops.cpp). */
+struct studio_action {
+  std::string op;    ///< "motion_push" …
+  std::string args;  ///< its checked fields, a JSON object text
+};
+
 /** What the board loop does for a page. */
 struct action {
   client_id from = 0;              ///< the page that asked (0: the server itself)
   std::optional<std::int64_t> id;  ///< the page's id for the answer
   std::variant<move_action, power_action, stop_action, capture_action, play_pose_action, motion_play_action,
-               motion_stop_action, refresh_action, motion_file_action>
+               motion_stop_action, refresh_action, motion_file_action, studio_action>
       body;  ///< what to do
 };
 

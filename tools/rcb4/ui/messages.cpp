@@ -2,7 +2,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "messages.hpp"
 
-#include <nlohmann/json.hpp>
+#include "message_parts.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -11,7 +11,7 @@
 namespace cli::ui {
 namespace {
 
-using json = nlohmann::ordered_json;
+using namespace detail;
 
 /** Deepest nesting a message may have: {"joints":{"a":1}} is 2, an array in there would be 3. */
 constexpr int max_depth = 3;
@@ -39,62 +39,6 @@ bool too_deep(std::string_view text) {
     }
   }
   return false;
-}
-
-struct refused {
-  std::string what;
-};
-
-std::string shown(std::string_view s) {
-  std::string out = "'";
-  for (char c : s.substr(0, max_name_bytes)) out += (static_cast<unsigned char>(c) < 0x20) ? '?' : c;
-  if (s.size() > max_name_bytes) out += "...";
-  return out + "'";
-}
-
-/** The keys of @p o must all be in @p known. */
-void only_keys(const json& o, std::string_view op, std::initializer_list<std::string_view> known) {
-  for (const auto& [k, v] : o.items()) {
-    bool found = false;
-    for (auto n : known) found = found || k == n;
-    if (!found) {
-      std::string list;
-      for (auto n : known) list += (list.empty() ? "" : ", ") + std::string(n);
-      throw refused{std::string(op) + ": unknown key " + shown(k) + " (known: " + list + ")"};
-    }
-  }
-}
-
-std::string name_of(const json& v, std::string_view op, std::string_view key) {
-  if (!v.is_string()) throw refused{std::string(op) + ": '" + std::string(key) + "' must be a string"};
-  const auto& s = v.get_ref<const std::string&>();
-  if (s.empty() || s.size() > max_name_bytes)
-    throw refused{std::string(op) + ": '" + std::string(key) + "' must be 1.." + std::to_string(max_name_bytes) +
-                  " bytes"};
-  return s;
-}
-
-std::optional<int> ms_of(const json& o, std::string_view op) {
-  const auto it = o.find("ms");
-  if (it == o.end() || it->is_null()) return std::nullopt;
-  if (!it->is_number_integer()) throw refused{std::string(op) + ": 'ms' must be a whole number of milliseconds"};
-  const auto v = it->get<std::int64_t>();
-  if (v < 0 || v > max_move_ms)
-    throw refused{std::string(op) + ": 'ms' is " + std::to_string(v) + ", outside 0.." + std::to_string(max_move_ms)};
-  return static_cast<int>(v);
-}
-
-bool flag_of(const json& o, std::string_view op, std::string_view key) {
-  const auto it = o.find(key);
-  if (it == o.end()) return false;
-  if (!it->is_boolean()) throw refused{std::string(op) + ": '" + std::string(key) + "' must be true or false"};
-  return it->get<bool>();
-}
-
-const json& required(const json& o, std::string_view op, std::string_view key) {
-  const auto it = o.find(key);
-  if (it == o.end()) throw refused{std::string(op) + ": '" + std::string(key) + "' is missing"};
-  return *it;
 }
 
 request body_of(const json& o, const std::string& op) {
@@ -166,9 +110,11 @@ request body_of(const json& o, const std::string& op) {
     if (v < 1 || v > 120) throw refused{"motion_file: slot " + std::to_string(v) + " is outside 1..120"};
     return motion_file_request{static_cast<unsigned>(v)};
   }
+  if (auto r = studio_body_of(o, op)) return std::move(*r);
   throw refused{"unknown op " + shown(op) +
                 " (known: control, release, move, free, hold, stop, capture, play_pose, motion_play, "
-                "motion_stop, refresh, motion_file)"};
+                "motion_stop, refresh, motion_file, " +
+                std::string(studio_ops_list) + ")"};
 }
 
 }  // namespace
@@ -194,6 +140,7 @@ std::string_view op_name(const request& r) noexcept {
     std::string_view operator()(const motion_stop_request&) const { return "motion_stop"; }
     std::string_view operator()(const refresh_request&) const { return "refresh"; }
     std::string_view operator()(const motion_file_request&) const { return "motion_file"; }
+    std::string_view operator()(const studio_request& s) const { return s.op; }
   };
   return std::visit(namer{}, r);
 }

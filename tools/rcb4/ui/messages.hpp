@@ -16,6 +16,22 @@
 //   {"op":"refresh"}                                   read the pose and motion lists again
 //   {"op":"motion_file","slot":2}                      ROM motion 2 as a motion file (YAML text; any page)
 //
+// The studio's (the motion editor and HTH4's tables; studio_messages.cpp checks them, the robot
+// services carry them out). Any page may read:
+//   {"op":"motion_list"}                               all 120 slots: used, name, bytes, seconds, broken
+//   {"op":"motion_pull","slot":10}                     a slot as a motion file: {"motion": {...}, "yaml": "..."}
+//   {"op":"motion_check","text":"robot: ..."}          a motion file (YAML or JSON text) parsed and compiled
+//   {"op":"buttons"}, {"op":"trims"}                   the button table (RAM, ROM), every joint's trim
+// Only the controlling page may change something:
+//   {"op":"motion_push","slot":10,"text":"...","dry_run":false}   write a motion (backup first)
+//   {"op":"motion_erase","slot":10}, {"op":"motion_resume"}
+//   {"op":"play_motion","text":"..."}                  play a motion file from the host ("stop" ends it)
+//   {"op":"button_set","buttons":"s1+up","slot":10}, {"op":"button_clear","buttons":"s1+up"}
+//   {"op":"button_press","buttons":"triangle","hold":true}, {"op":"button_release"}
+//   {"op":"trim_set","joints":{"left_knee":1.5},"persist":false}
+//   {"op":"hand","joint":"left_knee","degrees":30}     turn a freed joint by hand (the virtual board only)
+//   {"op":"rom_backup"}                                the whole ROM, base64, with its CRC-32
+//
 // Anything else (not JSON, an unknown op or key, a wrong type, a value out of range, more than
 // max_message_bytes, nesting deeper than an object of arrays) is a parse_error with the reason.
 #pragma once
@@ -30,8 +46,10 @@
 
 namespace cli::ui {
 
-/** The longest message a page may send; longer ones are refused unread. */
-inline constexpr std::size_t max_message_bytes = 16 * 1024;
+/** The longest message a page may send; longer ones are refused unread (a motion file's text fits). */
+inline constexpr std::size_t max_message_bytes = 64 * 1024;
+/** The longest motion file text a studio message may carry. */
+inline constexpr std::size_t max_text_bytes = 60 * 1024;
 /** The longest joint, group or pose name a message may carry. */
 inline constexpr std::size_t max_name_bytes = 64;
 /** The longest move or pose time a message may ask, ms (255 frames of 25 ms, protocol.md §5). */
@@ -76,10 +94,22 @@ struct motion_file_request {
   unsigned slot = 0;  ///< 1..120
 };
 
+/** A studio request (see the file comment): its op and its fields, each checked already. */
+struct studio_request {
+  std::string op;       ///< "motion_push" …
+  std::string args;     ///< the message's fields but op and id, as a JSON object text
+  bool writes = false;  ///< it changes the robot or its files: only the controlling page may ask
+};
+
+/** True for a studio op that only reads (any page may ask it); the others need control. */
+inline bool studio_reads(std::string_view op) noexcept {
+  return op == "motion_list" || op == "motion_pull" || op == "motion_check" || op == "buttons" || op == "trims";
+}
+
 /** What a page asks. */
-using request =
-    std::variant<take_control, release_control, move_request, power_request, stop_request, capture_request,
-                 play_pose_request, motion_play_request, motion_stop_request, refresh_request, motion_file_request>;
+using request = std::variant<take_control, release_control, move_request, power_request, stop_request, capture_request,
+                             play_pose_request, motion_play_request, motion_stop_request, refresh_request,
+                             motion_file_request, studio_request>;
 
 /** A well-formed message: its request and the id to answer with. */
 struct message {

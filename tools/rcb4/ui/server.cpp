@@ -309,9 +309,12 @@ class http_session : public std::enable_shared_from_this<http_session> {
     }
     if (req.method() != http::verb::get && req.method() != http::verb::head)
       return answer(req, http::status::method_not_allowed, "GET only", "text/plain; charset=utf-8", false);
-    const auto* f = file_for(req.target());
-    if (!f) return answer(req, http::status::not_found, "not found", "text/plain; charset=utf-8", false);
-    answer(req, http::status::ok, std::string(f->body), f->type, v.token_from_query);
+    if (const auto* f = file_for(req.target()))
+      return answer(req, http::status::ok, std::string(f->body), f->type, v.token_from_query);
+    const auto path = req.target().substr(0, req.target().find('?'));
+    for (const auto& f : server_.options().vendor)
+      if (f.path == path) return answer(req, http::status::ok, f.body, f.type, v.token_from_query);
+    answer(req, http::status::not_found, "not found", "text/plain; charset=utf-8", false);
   }
 
   void answer(const http_request& req, http::status status, std::string body, std::string_view type, bool set_cookie) {

@@ -2,7 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 //
 // What it refuses, and how:
-//  - a path that is not one of the embedded files: 404 (nothing is read from disk);
+//  - a path that is not one of the embedded files or of the vendor files read at start: 404
+//    (nothing is read from disk while serving);
 //  - without the token, when one is set: 401 (the URL printed at start carries it; the page's
 //    first load turns it into a SameSite=Strict cookie);
 //  - a Host that is not a loopback name, on a loopback listener (DNS rebinding): 421;
@@ -38,11 +39,19 @@ struct embedded_file {
 /** Every file the server serves. */
 std::span<const embedded_file> page_files();
 
+/** A file the server reads once at start (three.js from Debian's libjs-three): path, type, bytes. */
+struct served_file {
+  std::string path;  ///< "/vendor/three/build/three.module.js"
+  std::string type;  ///< its Content-Type
+  std::string body;  ///< its bytes
+};
+
 /** How the server listens. */
 struct server_options {
   boost::asio::ip::tcp::endpoint listen;  ///< where
   std::string token;                      ///< empty: no token needed (a loopback listener)
   std::size_t max_connections = 64;       ///< HTTP and WebSocket together
+  std::vector<served_file> vendor;        ///< served besides the page (read at start: nothing from disk later)
 };
 
 class ws_session;

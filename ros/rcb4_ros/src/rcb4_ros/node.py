@@ -56,6 +56,9 @@ class Rcb4Node:
         self.lock = threading.Lock()   # guards the trajectory and the streamed target
         self.trajectory = []           # [(due monotonic time, targets in degrees, frames)], next first
         self.stream = None             # (targets in degrees, received) from ~joint_command
+        self.freed = numpy.zeros(len(self.names), dtype=bool)  # freed joints: no command powers them again
+        self.halt = False              # stop: every joint under way holds where it is, at the next cycle
+        self.refused_at = {}           # refusal text -> when it was last logged (repeats once a second)
         self.link_ok, self.link_reason = True, ""
         self.cycles, self.errors, self.timeouts = 0, 0, 0
         self.rate_window = (time.monotonic(), 0)
@@ -74,6 +77,8 @@ class Rcb4Node:
         rospy.Service("~free", Trigger, lambda r: self.trigger("free", ""))
         rospy.Service("~hold", Trigger, lambda r: self.trigger("hold", ""))
         rospy.Service("~stop_motion", Trigger, lambda r: self.trigger("stop", None))
+        rospy.Service("~stop", Trigger, lambda r: self.trigger("halt", None))
+        rospy.Service("~resume_motion", Trigger, lambda r: self.trigger("resume", None))
         rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.where, len(self.names),
                       self.rate, self.period * 1000)
 
@@ -99,10 +104,25 @@ class Rcb4Node:
             targets[i] = deg
         return targets
 
+    def refuse(self, text):
+        """One line per refused command; the same refusal again within a second is not repeated."""
+        now = time.monotonic()
+        if now - self.refused_at.get(text, -10.0) >= 1.0:
+            rospy.logerr("rcb4: %s", text)
+            self.refused_at[text] = now
+            if len(self.refused_at) > 100:  # forget the old ones
+                self.refused_at = {k: v for k, v in self.refused_at.items() if now - v < 1.0}
+
+    def stop_now(self):
+        """Stop: what is under way is dropped and every joint that moves holds where it is now."""
+        with self.lock:
+            self.trajectory = []
+            self.stream = None
+            self.halt = True
+
     def on_trajectory(self, msg):
-        if not msg.points:  # an empty trajectory stops the one under way (the joints finish their current move)
-            with self.lock:
-                self.trajectory = []
+        if not msg.points:  # an empty trajectory: stop, every joint holds where it is now
+            self.stop_now()
             return
         try:
             points, last = [], 0.0
@@ -115,7 +135,7 @@ class Rcb4Node:
                 points += self.segment(last, t, before, targets)
                 before, last = targets, t
         except ValueError as e:
-            rospy.logerr_throttle(1.0, f"rcb4: trajectory refused, nothing moves: {e}")
+            self.refuse(f"trajectory refused, nothing moves: {e}")
             return
         stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
         begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
@@ -143,7 +163,7 @@ class Rcb4Node:
         try:
             targets = self.degrees_of(msg.name, msg.position, "joint_command")
         except ValueError as e:
-            rospy.logerr_throttle(1.0, f"rcb4: joint_command refused, nothing moves: {e}")
+            self.refuse(f"joint_command refused, nothing moves: {e}")
             return
         with self.lock:
             self.stream = targets
@@ -160,8 +180,7 @@ class Rcb4Node:
     def some_joints(self, what, names):
         """~free_joints / ~hold_joints: an empty message names nothing (~free and ~hold are for all)."""
         if not names.replace(",", " ").split():
-            rospy.logerr_throttle(1.0, f"rcb4: ~{what}_joints: the message names no joint, so nothing was done "
-                                       f"(~{what} is for every joint)")
+            self.refuse(f"~{what}_joints: the message names no joint, so nothing was done (~{what} is for every joint)")
             return
         self.queue(what, names)
 
@@ -189,7 +208,21 @@ class Rcb4Node:
                     names = [n[len(self.prefix):] if n.startswith(self.prefix) else n
                              for n in (argument or "").replace(",", " ").split()]
                     done = (self.board.free if what == "free" else self.board.hold)(*names)
+                    for n in done:
+                        self.freed[self.names.index(n)] = what == "free"
+                    # What was under way for a freed joint is dropped (this thread writes nothing in
+                    # between): its next point would power the joint again.
+                    dropped = self.drop([self.names.index(n) for n in done]) if what == "free" else []
                     message = f"{what}: {len(done)} joints"
+                    if what == "free" and dropped:
+                        message += f" (what was under way for {', '.join(dropped)} is dropped)"
+                        rospy.logwarn("rcb4: %s", message)
+                elif what == "halt":
+                    self.stop_now()
+                    message = "stopped: every joint holds where it is"
+                elif what == "resume":
+                    self.board.resume_motion()
+                    message = "the ROM program runs again"
                 elif what == "play":
                     self.board.play_motion(int(argument), wait=False)
                     message = f"playing motion {argument}"
@@ -203,8 +236,50 @@ class Rcb4Node:
                 reply[1].update(ok=ok, message=message)
                 reply[0].set()
 
+    def drop(self, indices):
+        """Drops what is under way (trajectory, stream) for the joints at @p indices; their names."""
+        idx = list(indices)
+        with self.lock:
+            busy = set()
+            rest = []
+            for at, t, frames in self.trajectory:
+                t = t.copy()
+                busy.update(i for i in idx if not math.isnan(t[i]))
+                t[idx] = numpy.nan
+                if not numpy.isnan(t).all():
+                    rest.append((at, t, frames))
+            self.trajectory = rest
+            if self.stream is not None:
+                busy.update(i for i in idx if not math.isnan(self.stream[i]))
+                self.stream = self.stream.copy()
+                self.stream[idx] = numpy.nan
+                if numpy.isnan(self.stream).all():
+                    self.stream = None
+        return [self.prefix + self.names[i] for i in sorted(busy)]
+
+    def halt_now(self):
+        """Every joint that is held holds where it is now (HOLD: the board stops its interpolation there)."""
+        held = [n for n, f in zip(self.names, self.freed) if not f]
+        if held:
+            self.board.hold(*held)
+
+    def without_freed(self, targets, what):
+        """@p targets with the freed joints left out (a position would power them again), said once."""
+        named = ~numpy.isnan(targets) & self.freed
+        if named.any():
+            self.refuse(f"{what}: {', '.join(self.prefix + self.names[i] for i in numpy.flatnonzero(named))} "
+                        f"{'is' if named.sum() == 1 else 'are'} free: left out (~hold or ~hold_joints first)")
+            targets = targets.copy()
+            targets[named] = numpy.nan
+        return targets
+
     def write_due(self):
         now = time.monotonic()
+        with self.lock:
+            halt, self.halt = self.halt, False
+        if halt:
+            self.halt_now()
+            return
         with self.lock:
             due = None
             while self.trajectory and self.trajectory[0][0] <= now:
@@ -214,10 +289,18 @@ class Rcb4Node:
         # The one rule for a move during a ROM motion (rcb4/robot/services/moves.hpp, through pyrcb4).
         refusal = pyrcb4.move_refusal(motion) if (due or stream is not None) else None
         if refusal:
-            rospy.logerr_throttle(1.0, f"rcb4: {refusal} (~stop_motion first)")
+            self.refuse(f"{refusal} (~stop_motion first)")
             with self.lock:
                 self.trajectory = []
             return
+        if due:
+            due = (due[0], self.without_freed(due[1], "trajectory"), due[2])
+            if numpy.isnan(due[1]).all():
+                due = None
+        if stream is not None:
+            stream = self.without_freed(stream, "joint_command")
+            if numpy.isnan(stream).all():
+                stream = None
         if due:
             # Points due in the same cycle (denser than the rate, or a late cycle): the last one, over
             # what is left of its time, so the joints do not hurry and then wait.

@@ -1,23 +1,11 @@
-// rcb4 ui: the page. One WebSocket to the server that owns the board; no library, no network
-// beyond this server. Messages: tools/rcb4/ui/messages.hpp (to the server), board_loop.cpp
-// and controller.cpp (from it).
-'use strict';
-
-const $ = (sel) => document.querySelector(sel);
-const el = (tag, attrs = {}, ...kids) => {
-  const e = document.createElement(tag);
-  for (const [k, v] of Object.entries(attrs)) {
-    if (k === 'class') e.className = v;
-    else if (k === 'text') e.textContent = v;
-    else if (k.startsWith('on')) e.addEventListener(k.slice(2), v);
-    else e.setAttribute(k, v);
-  }
-  for (const k of kids) e.append(k);
-  return e;
-};
-// A joint name with a line-break opportunity after each underscore (text nodes and <wbr>, no HTML).
-const breakable = (name) => name.split(/(?<=_)/).flatMap((part, i) => (i ? [el('wbr'), part] : [part]));
-const fmtDeg = (d) => (d === null || d === undefined ? '–' : (d > 0 ? '+' : '') + d.toFixed(1) + '°');
+// rcb4 ui: the page's entry (an ES module): the connection, the joints, poses, sensors, and the
+// studio's parts (view3d.js, editor.js, tables.js). One WebSocket to the server that owns the
+// board; nothing else is reached. Messages: tools/rcb4/ui/messages.hpp (to the server),
+// board_loop.cpp, controller.cpp and studio_ops.cpp (from it).
+import { $, el, breakable, fmtDeg } from './dom.js';
+import { createView } from './view3d.js';
+import { createEditor } from './editor.js';
+import { createTables } from './tables.js';
 
 const ui = {
   ws: null,
@@ -32,7 +20,20 @@ const ui = {
   history: [],           // [{t, battery, ad:[…]}] over the last 30 s
   lastState: null,
   motions: [],
+  pending: new Map(),    // request id → {resolve, reject}: the studio's requests
+  studio: null,          // {view, editor, tables} once the hello came
+  measured: {},          // joint → degrees, as last read
 };
+
+/** Sends @p msg and resolves with the server's reply (rejects with its error's words). */
+function request(msg) {
+  return new Promise((resolve, reject) => {
+    const id = send(msg);
+    if (id === null) return reject(new Error('not connected to rcb4 ui'));
+    const timer = setTimeout(() => { ui.pending.delete(id); reject(new Error(`${msg.op}: no answer in 60 s`)); }, 60000);
+    ui.pending.set(id, { resolve: (m) => { clearTimeout(timer); resolve(m); }, reject: (e) => { clearTimeout(timer); reject(e); } });
+  });
+}
 
 // --- the connection -------------------------------------------------------------------------------
 
@@ -73,11 +74,13 @@ function say(text, kind = 'note') {
 const on = {
   hello(m) {
     ui.hello = m;
-    document.title = `${m.robot} — rcb4 ui`;
+    document.title = `${m.robot} — rcb4 studio`;
     $('#robot').textContent = m.robot;
     $('#version').textContent = `rcb4 ${m.version}`;
     buildJoints(m);
+    buildStudio(m);
   },
+  played(m) { ui.studio?.editor.played(m); },
   role(m) { setRole(m.role, m.controlled); },
   lists(m) {
     ui.motions = m.motions;
@@ -86,9 +89,17 @@ const on = {
   },
   state(m) {
     ui.lastState = m;
+    window.rcb4State = m;  // the tests and the benchmark read it
     renderState(m);
+    ui.hello?.joints.forEach((j, i) => { ui.measured[j.name] = m.angles[i]; });
+    if (ui.studio) {
+      ui.studio.view?.setMeasured(ui.measured);
+      ui.studio.tables.running(m.motion.running ? m.motion.slot : null);
+    }
   },
   reply(m) {
+    const p = ui.pending.get(m.id);
+    if (p) { ui.pending.delete(m.id); p.resolve(m); return; }
     const what = {
       capture: () => `captured ${m.joints} joints as ${m.name}` + (m.left_out?.length ? ` (left out: ${m.left_out.join(', ')})` : '') +
         (m.clamped?.length ? ` (saved at the limit: ${m.clamped.join(', ')})` : ''),
@@ -105,7 +116,11 @@ const on = {
     if (what) say(what());
   },
   note(m) { say((m.clamped || []).join('; ')); },
-  error(m) { say((m.op ? m.op + ': ' : '') + m.message, 'error'); },
+  error(m) {
+    const p = ui.pending.get(m.id);
+    if (p) { ui.pending.delete(m.id); p.reject(new Error((m.op ? m.op + ': ' : '') + m.message)); return; }
+    say((m.op ? m.op + ': ' : '') + m.message, 'error');
+  },
 };
 
 // --- joints -----------------------------------------------------------------------------------------
@@ -155,7 +170,7 @@ function jointRow(j) {
     type: 'range', min: j.lower, max: j.upper, step: 0.5, value: Math.min(Math.max(0, j.lower), j.upper),
     'data-joint': j.name, 'aria-label': `${j.name} target in degrees`,
   });
-  const marker = el('span', { class: 'measured', title: 'measured angle' });
+  const marker = el('span', { class: 'measured', title: 'measured angle' });  // under the thumb's centre (style.css)
   const angle = el('span', { class: 'angle', text: '–', title: 'measured angle' });
   const target = el('span', { class: 'target', text: '' });
   const row = el('div', { class: 'joint', 'data-joint': j.name },
@@ -201,7 +216,8 @@ function renderState(s) {
     r.angle.textContent = fmtDeg(s.angles[i]);
     if (s.angles[i] !== null) {
       const f = (s.angles[i] - j.lower) / (j.upper - j.lower);
-      r.marker.style.left = `calc(${(Math.min(Math.max(f, 0), 1) * 100).toFixed(2)}% - 1px)`;
+      // The thumb's centre runs from half a thumb in to half a thumb short of the end (--thumb).
+      r.marker.style.left = `calc(var(--thumb) / 2 + (100% - var(--thumb)) * ${Math.min(Math.max(f, 0), 1).toFixed(4)} - 1px)`;
       r.marker.hidden = false;
     } else {
       r.marker.hidden = true;
@@ -252,6 +268,11 @@ function setRole(role, controlled) {
   const b = $('#control');
   b.textContent = role === 'control' ? 'Release' : 'Take control';
   b.disabled = role !== 'control' && controlled;
+  // A watching page says why its controls are off, where they are.
+  const note = $('#role-note');
+  note.hidden = role === 'control';
+  note.textContent = controlled ? 'Another page controls the robot: this one watches, so its controls are off until that page releases control or closes.'
+    : 'This page watches: Take control to move the robot, edit trims and buttons, or write motions.';
 }
 
 // --- poses and motions -------------------------------------------------------------------------------
@@ -345,6 +366,43 @@ function plot(canvas, now, series, colours, fixed) {
   });
 }
 
+// --- the studio -------------------------------------------------------------------------------------------
+
+async function buildStudio(h) {
+  const ctx = {
+    hello: h,
+    request,
+    send,
+    say,
+    view: null,
+    measured: () => ({ ...ui.measured }),
+    controlling: () => ui.role === 'control',
+    controls: () => setRole(ui.role, ui.controlled),
+    refresh: () => { send({ op: 'refresh' }); ui.studio?.tables.list(); },
+    edit: async (slot) => { $('#ed-slot').value = slot; $('#ed-pull').click(); },
+  };
+  const editor = createEditor($('#editor'), ctx);
+  const tables = createTables($('#tables'), ctx);
+  ui.studio = { view: null, editor, tables };
+  tables.list();
+  // Shift+drag in the 3D view: the virtual board's hand turns a freed joint (a person posing it).
+  const onHand = h.link.virtual ? (joint, degrees) => request({ op: 'hand', joint, degrees }).catch((e) => say(e.message, 'error')) : null;
+  const view = await createView($('#view3d'), h, { onSelect: selectJoint, onHand });
+  ctx.view = view;
+  ui.studio.view = view;
+  window.rcb4Studio = { view, editor, tables, hello: h };  // for the tests and the benchmark (frames drawn, state)
+  if (view) { view.setMeasured(ui.measured); editor.render(); }
+}
+
+function selectJoint(name) {
+  for (const r of document.querySelectorAll('.joint.selected')) r.classList.remove('selected');
+  const row = ui.rows.get(name)?.row;
+  if (!row) return;
+  row.classList.add('selected');
+  row.scrollIntoView({ block: 'nearest' });
+  say(`${name} selected`);
+}
+
 // --- the buttons ----------------------------------------------------------------------------------------
 
 function wire() {
@@ -353,6 +411,7 @@ function wire() {
   $('#hold-all').addEventListener('click', () => send({ op: 'hold', joints: ['all'] }));
   $('#stop').addEventListener('click', () => send({ op: 'stop' }));
   $('#motion-stop').addEventListener('click', () => send({ op: 'motion_stop' }));
+  $('#motions-resume').addEventListener('click', () => request({ op: 'motion_resume' }).then(() => say('the ROM program runs again'), (e) => say(e.message, 'error')));
   $('#refresh').addEventListener('click', () => send({ op: 'refresh' }));
   $('#capture-form').addEventListener('submit', (ev) => {
     ev.preventDefault();

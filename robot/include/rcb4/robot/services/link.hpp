@@ -28,10 +28,11 @@ namespace rcb4::robot::services {
 
 /** Why a workflow refused (each front end maps it once: exit code, exception class). */
 enum class refusal_kind {
-  board,  ///< the board's state forbids it (a motion runs, a slot is broken): tool exit 1, pyrcb4 BoardRefused
-  usage,  ///< the request or its file is wrong (a bad number, a file that does not read): exit 2, UsageError
-  limit,  ///< a joint would go beyond its limit: exit 2, LimitError
-  line,   ///< the line failed part way through a workflow (refused::code says how): exit 3 or 4, DeviceError
+  board,    ///< the board's state forbids it (a motion runs, a slot is broken): tool exit 1, pyrcb4 BoardRefused
+  usage,    ///< the request or its file is wrong (a bad number, a file that does not read): exit 2, UsageError
+  limit,    ///< a joint would go beyond its limit: exit 2, LimitError
+  line,     ///< the line failed part way through a workflow (refused::code says how): exit 3 or 4, DeviceError
+  timeout,  ///< the board did not finish in the time allowed (a called motion that runs on): exit 4, TimeoutError
 };
 
 /** A workflow that did not do what it was asked, and why; nothing was written unless the message says so. */

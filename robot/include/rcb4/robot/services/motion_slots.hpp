@@ -16,6 +16,7 @@
 #pragma once
 
 #include <rcb4/motion/disassemble.hpp>
+#include <rcb4/motion/player.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/link.hpp>
 
@@ -50,6 +51,12 @@ std::vector<std::uint8_t> read_rom(link& l, std::uint32_t at, std::size_t size, 
 /** The bytes of the code the board reaches in @p code (from the slot's start, in address order). */
 std::size_t code_size(const motion::listing& code);
 
+/**
+ * A program's play time in words, as the board runs it (loops counted): "plays 1.50 s", "plays
+ * 2.10 s and 1 call of other motions, no button held", "plays until stopped: ...".
+ */
+std::string play_time_text(const motion::play_estimate& e, output_period period);
+
 /** What a push did. */
 struct push_report {
   unsigned motion = 0;              ///< the slot's number
@@ -59,7 +66,8 @@ struct push_report {
   bool unchanged = false;           ///< the slot already held them: nothing written
   bool dry_run = false;             ///< checked and assembled only
   std::string backup;               ///< where the slot's old bytes are (empty when nothing was written)
-  std::string summary;              ///< "6 steps, 5 poses (1.50 s of moves)", or a .bin's content
+  std::string summary;              ///< "6 steps, 5 poses (plays 1.50 s)", or a .bin's content
+  std::string name;                 ///< the name the slot now has (a motion file's name:), or empty
   std::vector<std::string> notes;   ///< what the motion does that may not be meant
 };
 
@@ -89,8 +97,12 @@ struct erase_report {
   std::string backup;         ///< where its old bytes are
 };
 
-/** Empties motion @p n (0xFF, as erased ROM reads), its old bytes saved by @p backup first; refused as a push is. */
-erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup);
+/**
+ * Empties motion @p n (0xFF, as erased ROM reads), its old bytes saved by @p backup first; refused
+ * as a push is. With @p robot, the slot's name (slot_names.hpp) is forgotten too.
+ */
+erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup,
+                          const std::string& robot = {});
 
 /** What a pull read. */
 struct pull_report {
@@ -101,6 +113,7 @@ struct pull_report {
   motion_document document;   ///< the motion as a file says it
   std::size_t poses = 0;      ///< poses in it
   long long pose_ms = 0;      ///< their times, summed (one pass)
+  std::string plays;          ///< how long it plays as the board runs it, loops counted (play_time_text)
   output_period period{};     ///< the board's output period
   std::string beyond;         ///< why the file would not push back as it is (a pose beyond a limit), or empty
 };

@@ -1,0 +1,127 @@
+// rcb4 — robot services: a motion file played from the host (see rcb4/robot/services/host_play.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/motion/assemble.hpp>
+#include <rcb4/ops/memory.hpp>
+#include <rcb4/ops/servos.hpp>
+#include <rcb4/robot/services/host_play.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/moves.hpp>
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace rcb4::robot::services {
+namespace {
+
+namespace mo = rcb4::motion;
+using namespace std::chrono_literals;
+using rcb4::ops::memory;
+
+/** How often a called ROM motion's end is looked for (the board refreshes its state about as often). */
+constexpr std::chrono::milliseconds callee_poll = 50ms;
+
+compiled_motion checked(link& l, const model& robot, const rom_layout& layout, output_period period,
+                        const motion_document& d, const std::string& file, bool rescale) {
+  auto c = to_program(d, robot, layout, period, rescale);
+  if (!ok(c))
+    throw refused(refusal_kind::usage, fmt::format("{}: {} (nothing was sent)", file, std::get<problem>(c).message));
+  auto cm = std::get<compiled_motion>(std::move(c));
+  {
+    const mo::player probe(cm.program);
+    if (!probe.error().empty()) throw refused(refusal_kind::usage, fmt::format("{}: {}", file, probe.error()));
+  }
+  require_no_motion(l, layout);
+  // Every servo a pose moves needs a slot: the board ignores one it has none for.
+  const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
+  const auto slots = rcb4::ops::parse_allocation_table(table);
+  if (!slots) l.failed(slots.error());
+  for (const auto& st : cm.program.steps)
+    if (const auto* p = std::get_if<mo::pose>(&st))
+      for (const auto& e : p->targets)
+        if (std::none_of(slots->begin(), slots->end(), [&](const auto& k) { return k.ics == e.ics; })) {
+          const auto* j = robot.on(e.ics);
+          throw refused(refusal_kind::board,
+                        fmt::format("{} (ICS {}) has no slot on the board: its poses would not move it, so nothing "
+                                    "was sent",
+                                    j ? j->name : "a servo", e.ics.value()),
+                        "rcb4 scan shows the board's slots");
+        }
+  // Its calls checked as a push checks them (the host plays the poses; the board runs each call).
+  const auto whole = mo::slot{rcb4::rom_address{}, 0x40000};
+  if (const auto code = mo::assemble(cm.program, whole); mo::ok(code))
+    check_calls(l, layout, mo::disassemble(std::get<std::vector<std::uint8_t>>(code), whole), &cm.program, d.where,
+                "sent");
+  return cm;
+}
+
+}  // namespace
+
+host_play::host_play(link& l, const model& robot, const rom_layout& layout, output_period period,
+                     const motion_document& d, std::string file, bool rescale, std::chrono::milliseconds callee_limit)
+    : l_(l),
+      layout_(layout),
+      period_(period),
+      file_(std::move(file)),
+      callee_limit_(callee_limit),
+      compiled_(checked(l, robot, layout, period, d, file_, rescale)),
+      player_(compiled_.program) {}
+
+std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::milliseconds now) {
+  if (callee_since_) {
+    // Its end, polled as the board refreshes the state; it may not run past its limit.
+    if (run(l_, rcb4::ops::read_motion_state(layout_)).running) {
+      if (now - *callee_since_ < callee_limit_) return now + callee_poll;
+      run(l_, rcb4::ops::stop_motion{});
+      callee_since_.reset();
+      throw refused(refusal_kind::timeout,
+                    fmt::format("{}: motion {}, called at step {}, still ran after {:g} s: stopped", file_, *callee_,
+                                player_.step(), std::chrono::duration<double>(callee_limit_).count()),
+                    "a motion that loops for ever ends only when it is stopped; allow it longer");
+    }
+    callee_since_.reset();
+    ready_ = now;
+  }
+  if (now < ready_) return ready_;
+  if (finished_) return std::nullopt;
+  const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period_));
+  for (;;) {
+    const auto a = player_.next();
+    if (std::holds_alternative<mo::finished>(a)) {
+      finished_ = true;
+      if (!player_.error().empty())
+        throw refused(refusal_kind::usage,
+                      fmt::format("{}: stopped at step {}: {}", file_, player_.step(), player_.error()));
+      if (ready_ > now) return ready_;
+      return std::nullopt;
+    }
+    if (const auto* snd = std::get_if<mo::send>(&a)) {
+      run(l_, rcb4::ops::detail::ack_sequence({snd->cmd}));
+      ready_ = std::max(ready_, now) + snd->frames * frame;
+      if (ready_ > now) return ready_;
+    } else if (const auto* r = std::get_if<mo::read_value>(&a)) {
+      const auto v = run(l_, rcb4::ops::read_memory(memory::ram, r->address.value(), r->size));
+      player_.value(static_cast<std::uint16_t>(v[0] | (r->size > 1 ? v[1] << 8 : 0)));
+    } else if (const auto* k = std::get_if<mo::play_code>(&a)) {
+      const std::uint32_t at = k->address.value(), base = layout_.motion_base.value();
+      if (!(at >= base && (at - base) % layout_.slot_size == 0 &&
+            (at - base) / layout_.slot_size < layout_.motion_count))
+        throw refused(refusal_kind::usage,
+                      fmt::format("{}: step {} calls 0x{:06X}, which starts no motion slot ({} layout): from the "
+                                  "host only whole motions are played",
+                                  file_, player_.step(), at, layout_.name));
+      callee_ = (at - base) / layout_.slot_size + 1;
+      run(l_, rcb4::ops::play_motion(*callee_, layout_));
+      callee_since_ = now;
+      return now + callee_poll;
+    }
+  }
+}
+
+void host_play::stop() {
+  if (!callee_since_) return;
+  callee_since_.reset();
+  run(l_, rcb4::ops::stop_motion{});
+}
+
+}  // namespace rcb4::robot::services

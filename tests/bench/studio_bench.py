@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+# The studio's speed, printed (not asserted): frames the 3D view draws per second while the board
+# is read at the page's period, and how long a slider change takes to reach the board (the
+# page's performance clock, from the slider's input event to the first state whose target for that
+# joint is the new angle), on `rcb4 serve --pty --pace` (the line at 1.25 Mbaud), in Debian's
+# headless Chromium drawing WebGL with SwiftShader (a CPU: a GPU draws faster).
+#   studio_bench.py RCB4
+# SPDX-License-Identifier: BSL-1.0
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "integration"))
+from uihelp import tools  # noqa: E402
+
+RCB4 = sys.argv[1]
+run, serve, Ui, browser, wait_until, joints_on = tools(RCB4)
+
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--pace"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+ui = Ui("--device", dev, "--baud", "1250000", "ui", "--listen", "127.0.0.1:0", "--poses", "/tmp/rcb4-bench-poses")
+d = browser()
+try:
+    d.get(ui.url)
+    wait_until(lambda: d.execute_script("return !!(window.rcb4Studio && window.rcb4Studio.view)"), timeout=30)
+    wait_until(lambda: d.execute_script("return document.querySelector('#role').textContent") == "controlling")
+    names = d.execute_script("return window.rcb4Studio.hello.joints.map((j) => j.name)")
+    f0, s0, t0 = d.execute_script("return [window.rcb4Studio.view.stats.frames, window.rcb4State.seq, performance.now()]")
+    time.sleep(5)
+    f1, s1, t1 = d.execute_script("return [window.rcb4Studio.view.stats.frames, window.rcb4State.seq, performance.now()]")
+    secs = (t1 - t0) / 1000
+    lat = []
+    for k in range(12):
+        target = 20 if k % 2 == 0 else -20
+        ms = d.execute_async_script("""
+            const [name, deg, i, done] = arguments;
+            const s = document.querySelector(`.joint[data-joint="${name}"] input[type=range]`);
+            const t0 = performance.now();
+            s.value = deg; s.dispatchEvent(new Event('input'));
+            const poll = () => {
+              const st = window.rcb4State;
+              if (st && st.targets[i] !== null && Math.abs(st.targets[i] - deg) < 0.6) done(performance.now() - t0);
+              else if (performance.now() - t0 > 5000) done(null);
+              else setTimeout(poll, 1);
+            };
+            poll();""", "head_yaw", target, names.index("head_yaw"))
+        if ms is not None:
+            lat.append(ms)
+        time.sleep(0.6)
+    period = d.execute_script("return window.rcb4Studio.hello.period_ms")
+    print(f"3D view: {(f1 - f0) / secs:.1f} frames/s while the board is read {(s1 - s0) / secs:.1f} times/s "
+          f"(the page's period {period} ms)")
+    if lat:
+        print(f"slider -> the board's target: median {statistics.median(lat):.1f} ms, max {max(lat):.1f} ms over {len(lat)} "
+              f"moves (the page gathers moves for 40 ms, the server sends at most one per 40 ms, the board is read every "
+              f"{period} ms)")
+finally:
+    d.quit()
+    ui.stop()
+    srv.terminate()
+    srv.wait(timeout=10)

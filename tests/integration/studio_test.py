@@ -1,0 +1,215 @@
+#!/usr/bin/env python3
+# rcb4 studio (`rcb4 ui`) as an HTH4 user clicks through it, in Debian's headless Chromium
+# (selenium) over `rcb4 serve --pty`: the robot drawn in 3D changes when a joint moves; a
+# three-pose motion built in the editor (two poses captured, one typed), reordered and retimed,
+# previewed, pushed to slot 10 with its backup named; on the board through the tool (the ui
+# stopped: the pty has one owner) `motion show 10` lists three CONST frames and a RETURN and
+# `motion play 10 --wait` ends at the last pose; pulled back, the editor shows the same poses; a
+# button assigned on the remote's picture plays it. Screenshots of the studio for the README.
+# Usage: studio_test.py RCB4 SCREENSHOT_DIR
+# SPDX-License-Identifier: BSL-1.0
+import json
+import os
+import sys
+import tempfile
+import time
+
+from checks import check, finish
+from uihelp import tools
+
+RCB4, SHOTS = sys.argv[1], sys.argv[2]
+run, serve, Ui, browser, wait_until, joints_on = tools(RCB4)
+
+
+def js(driver, code, *args):
+    return driver.execute_script(code, *args)
+
+
+def click(driver, by, what):
+    from selenium.webdriver.common.by import By
+    e = driver.find_element(By.CSS_SELECTOR if by == "css" else By.ID, what)
+    js(driver, "arguments[0].scrollIntoView({block: 'center'})", e)
+    e.click()
+    return e
+
+
+def message(driver):
+    return js(driver, "return document.querySelector('#message').textContent")
+
+
+def slide(driver, joint, degrees):
+    """A joint's slider in the joints panel set as a person drags it (the page sends the move)."""
+    js(driver, """const s = document.querySelector(`.joint[data-joint="${arguments[0]}"] input[type=range]`);
+                  s.value = arguments[1]; s.dispatchEvent(new Event('input'));""", joint, degrees)
+
+
+def measured(driver, joint):
+    """The joint's measured angle in the page's latest state (the hello's joint order)."""
+    return js(driver, "return window.rcb4State && window.rcb4State.angles[arguments[0]]", NAMES.index(joint))
+
+
+def shot(driver, name):
+    """A screenshot of the studio's column (the 3D view and the editor), for the README."""
+    driver.set_window_size(1400, 1500)
+    js(driver, "window.scrollTo(0, 0)")
+    time.sleep(0.5)  # the view resizes to the window, then draws
+    driver.save_screenshot(os.path.join(SHOTS, name))
+    driver.set_window_size(1400, 1080)
+
+
+def canvas_png(driver):
+    return js(driver, "return document.querySelector('#view3d canvas').toDataURL('image/png')")
+
+
+NAMES = None
+with serve() as dev, tempfile.TemporaryDirectory() as poses:
+    os.environ["RCB4_SLOT_NAMES"] = os.path.join(poses, "slot-names.yaml")
+    ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
+    driver = browser()
+    try:
+        from selenium.webdriver.common.by import By
+        driver.get(ui.url)
+        check(wait_until(lambda: js(driver, "return !!(window.rcb4Studio && window.rcb4Studio.view)"), timeout=20),
+              "the studio draws the robot (three.js from Debian, WebGL)")
+        NAMES = js(driver, "return window.rcb4Studio.hello.joints.map((j) => j.name)")
+        wait_until(lambda: driver.find_element(By.ID, "role").text == "controlling")
+        wait_until(lambda: js(driver, "return window.rcb4Studio.view.stats.frames") > 10)
+        gl = js(driver, "const c = document.querySelector('#view3d canvas'); return !!(c.getContext('webgl2') || c.getContext('webgl'))")
+        check(gl, "the 3D view is a WebGL canvas")
+
+        # The 3D view changes when a joint moves.
+        before = canvas_png(driver)
+        slide(driver, "left_shoulder_pitch", 80)
+        check(wait_until(lambda: abs((measured(driver, "left_shoulder_pitch") or 0) - 80) < 1, timeout=10),
+              "the slider moved left_shoulder_pitch to 80")
+        time.sleep(0.3)
+        check(canvas_png(driver) != before, "the 3D view changed as the joint moved")
+        slide(driver, "left_shoulder_pitch", 0)
+        wait_until(lambda: abs(measured(driver, "left_shoulder_pitch") or 99) < 1, timeout=10)
+
+        # Build a motion: two poses captured from the robot, one typed.
+        click(driver, "id", "ed-new")
+        driver.find_element(By.ID, "ed-name").send_keys("knee test")
+        slide(driver, "left_knee", 30)
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) - 30) < 0.6, timeout=10)
+        click(driver, "id", "ed-capture")
+        slide(driver, "left_knee", -20)
+        slide(driver, "head_yaw", 15)
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 20) < 0.6
+                   and abs((measured(driver, "head_yaw") or 0) - 15) < 0.6, timeout=10)
+        click(driver, "id", "ed-capture")
+        js(driver, "document.querySelector('#ed-kind').value = 'pose'")
+        click(driver, "id", "ed-add")  # a pose from the ghost (the last one), then typed
+        js(driver, """const n = document.querySelector('.pose-joint[data-joint="left_knee"] input[type=number]');
+                      n.value = 10; n.dispatchEvent(new Event('change'));""")
+        doc = js(driver, "return window.rcb4Studio.editor.doc")
+        kinds = ["pose" if isinstance(s, dict) and "pose" in s else s for s in doc["steps"]]
+        knees = [s["pose"].get("left_knee") for s in doc["steps"] if isinstance(s, dict) and "pose" in s]
+        check(kinds == ["pose", "pose", "pose", "end"] and knees == [30, -20, 10],
+              f"three poses: two captured (30, -20), one typed (10), then end ({kinds}, {knees})")
+        # Reordered (the typed pose up one, and back down with the keyboard), retimed.
+        click(driver, "id", "ed-up")
+        knees = [s["pose"]["left_knee"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
+        check(knees == [30, 10, -20], f"↑ moves the selected pose up ({knees})")
+        js(driver, "document.querySelector('#ed-steps').focus()")  # the selection stays on the pose moved up
+        from selenium.webdriver.common.keys import Keys
+        from selenium.webdriver.common.action_chains import ActionChains
+        ActionChains(driver).key_down(Keys.ALT).send_keys(Keys.ARROW_DOWN).key_up(Keys.ALT).perform()
+        doc = js(driver, "return window.rcb4Studio.editor.doc")
+        knees = [s["pose"]["left_knee"] for s in doc["steps"][:3]]
+        check(knees == [30, -20, 10], f"Alt+↓ (the keyboard) moves it back ({knees})")
+        # Retime the second pose.
+        click(driver, "css", '#ed-steps li[data-step="1"]')
+        js(driver, "const t = document.querySelector('#ed-time'); t.value = 400; t.dispatchEvent(new Event('change'))")
+        times = [s["time_ms"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
+        check(times == [500, 400, 500], f"the second pose retimed to 400 ms ({times})")
+        click(driver, "id", "ed-undo")
+        click(driver, "id", "ed-redo")
+        times = [s["time_ms"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
+        check(times == [500, 400, 500], f"undo, redo: the same ({times})")
+        # A typed value beyond a limit is refused, not taken.
+        js(driver, """const n = document.querySelector('.pose-joint[data-joint="head_yaw"] input[type=number]');
+                      n.value = 300; n.dispatchEvent(new Event('change'));""")
+        check("beyond its limits" in message(driver)
+              and js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose.head_yaw") == 15,
+              f"300° on head_yaw is refused, the pose keeps 15 ({message(driver)!r})")
+        # Previewed in 3D without the robot: the ghost moves at the authored timing.
+        click(driver, "id", "ed-preview")
+        shown = wait_until(lambda: "preview:" in driver.find_element(By.ID, "ed-result").text and
+                           driver.find_element(By.ID, "ed-result").text, timeout=10)
+        check(shown, "the preview runs to its end")
+        import re
+        m = re.search(r"preview: ([\d.]+) s of motion, shown in ([\d.]+) s", shown or "")
+        check(m and float(m.group(1)) == 1.4 and 1.4 <= float(m.group(2)) < 1.6,
+              f"at the authored timing: 1.4 s of poses shown in 1.4 s ({shown!r})")
+        check(abs((measured(driver, "left_knee") or 0) + 20) < 1, "a preview does not move the robot")
+        shot(driver, "rcb4-studio.png")
+
+        # Pushed to slot 10: the backup named.
+        js(driver, "document.querySelector('#ed-slot').value = 10")
+        click(driver, "id", "ed-push")
+        check(wait_until(lambda: "backup:" in driver.find_element(By.ID, "ed-result").text, timeout=20),
+              f"pushed to slot 10, its backup named ({message(driver)!r})")
+        backup = driver.find_element(By.ID, "ed-result").text.split("backup: ")[-1]
+        check(os.path.exists(backup) and os.path.getsize(backup) == 2048, f"the backup is the old slot ({backup})")
+        # The slot table shows it, by its name.
+        click(driver, "id", "slots-refresh")
+        check(wait_until(lambda: "knee test" in js(driver, "return document.querySelector('#slots tr[data-slot=\"10\"]').textContent"),
+                         timeout=10), "the motion table lists slot 10 as 'knee test'")
+        # A button assigned on the remote's picture plays it.
+        click(driver, "css", "#buttons-panel summary")
+        click(driver, "css", '#remote .key[data-button="triangle"]')
+        click(driver, "css", '#remote .key[data-button="circle"]')
+        js(driver, "document.querySelector('#button-slot').value = 10")
+        click(driver, "id", "button-set")
+        check(wait_until(lambda: "plays motion 10" in message(driver), timeout=10), f"triangle+circle assigned ({message(driver)!r})")
+        slide(driver, "left_knee", 0)
+        wait_until(lambda: abs(measured(driver, "left_knee") or 99) < 0.6, timeout=10)
+        click(driver, "id", "button-press")
+        played = wait_until(lambda: (js(driver, "return window.rcb4State.motion") or {}).get("slot") == 10, timeout=5)
+        check(played, "pressing them plays motion 10")
+        check(wait_until(lambda: abs((measured(driver, "left_knee") or 0) - 10) < 1
+                         and not js(driver, "return window.rcb4State.motion.running"), timeout=10),
+              f"and it ends at its last pose ({measured(driver, 'left_knee')})")
+        shot(driver, "rcb4-studio-buttons.png")
+    finally:
+        driver.quit()
+        ui.stop()
+
+    # On the board, through the tool.
+    rc, out, err = run("--device", dev, "motion", "show", "10")
+    consts = out.count("CONST")
+    check(rc == 0 and consts == 3 and "RETURN" in out, f"motion show 10: three CONST frames and a RETURN ({consts}; {err.strip()!r})")
+    rc, out, err = run("--device", dev, "motion", "play", "10", "--wait", "--timeout", "10")
+    j = joints_on(dev)
+    check(rc == 0 and abs(j["left_knee"]["degrees"] - 10) < 1 and abs(j["head_yaw"]["degrees"] - 15) < 1,
+          f"motion play 10 --wait ends at the last pose ({j.get('left_knee', {}).get('degrees')}, {err.strip()!r})")
+
+    # Pulled back into the editor: the same poses.
+    ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
+    driver = browser()
+    try:
+        driver.get(ui.url)
+        wait_until(lambda: js(driver, "return !!(window.rcb4Studio && window.rcb4Studio.editor)"), timeout=20)
+        js(driver, "document.querySelector('#ed-slot').value = 10")
+        click(driver, "id", "ed-pull")
+        wait_until(lambda: "in the editor" in message(driver), timeout=10)
+        doc = js(driver, "return window.rcb4Studio.editor.doc")
+        poses_back = [s for s in doc["steps"] if isinstance(s, dict) and "pose" in s]
+        check(len(poses_back) == 3 and [round(p["pose"]["left_knee"]) for p in poses_back] == [30, -20, 10]
+              and [p["time_ms"] for p in poses_back] == [500, 400, 500] and doc["name"] == "knee test",
+              f"pulled back: the same three poses and times, and the name ({poses_back}, {doc.get('name')})")
+        wait_until(lambda: js(driver, "return window.rcb4Studio.view && window.rcb4Studio.view.stats.frames") > 5)
+        shot(driver, "rcb4-studio-editor.png")
+        # A second page watching is told why its controls are off.
+        second = browser()
+        try:
+            second.get(ui.url)
+            note = wait_until(lambda: second.find_element("id", "role-note").text, timeout=10)
+            check(note and "Another page controls the robot" in note, f"a watching page says why its controls are off ({note!r})")
+        finally:
+            second.quit()
+    finally:
+        driver.quit()
+        ui.stop()
+finish()

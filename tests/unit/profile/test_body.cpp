@@ -1,0 +1,105 @@
+// A profile's body (kinematics:): the built-in robots', the mistakes refused with their place, URDF.
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/robot/profile.hpp>
+#include <rcb4/robot/urdf.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace rcb4::robot;
+
+namespace {
+std::string error_of(const std::string& text) {
+  try {
+    parse_profile(text, "bad.yaml");
+  } catch (const profile_error& e) {
+    return e.what();
+  }
+  FAIL("the profile was accepted:\n" << text);
+  return {};
+}
+// Two joints: a knee on a thigh on a body.
+const std::string head =
+    "robot: t\n"
+    "joints:\n"
+    "  hip: {ics: 1, lower: -90, upper: 90}\n"
+    "  knee: {ics: 2, lower: -90, upper: 90}\n"
+    "kinematics:\n"
+    "  links:\n"
+    "    body: {box: [50, 80, 100]}\n"
+    "    thigh: {box: [30, 30, 80], xyz: [0, 0, -40]}\n"
+    "    shin: [{cylinder: [15, 80], xyz: [0, 0, -40]}, {sphere: 10}]\n"
+    "  joints:\n";
+}  // namespace
+
+TEST_CASE("body: the built-in robots place every joint, from one root", "[profile][body]") {
+  for (const char* name : {"khr-3hv", "kxr-l2"}) {
+    const auto m = open_profile(name);
+    REQUIRE(m.body());
+    CHECK(m.body()->root()->name == (std::string(name) == "khr-3hv" ? "pelvis" : "torso"));
+    for (const auto& j : m.joints()) CHECK(m.body()->find_joint(j.name));
+    CHECK_FALSE(m.body()->source.empty());
+  }
+}
+
+TEST_CASE("body: a sound body, and each mistake with its line", "[profile][body]") {
+  const auto ok = parse_profile(head +
+                                    "    hip: {parent: body, child: thigh, xyz: [0, 20, -50], axis: [0, 1, 0]}\n"
+                                    "    knee: {parent: thigh, child: shin, xyz: [0, 0, -80], axis: [0, 1, 0]}\n",
+                                "ok.yaml");
+  REQUIRE(ok.body());
+  CHECK(ok.body()->links.at(2).shapes.size() == 2);
+  CHECK(ok.body()->find_joint("knee")->xyz[2] == -80);
+  // An unknown parent.
+  CHECK(error_of(head + "    hip: {parent: bdy, child: thigh}\n    knee: {parent: thigh, child: shin}\n") ==
+        "bad.yaml:11:5: hip: its parent 'bdy' is no link");
+  // A cycle: the body's parent is the shin, whose parent is the thigh, whose parent is the body.
+  CHECK(error_of(head + "    hip: {parent: body, child: thigh}\n    knee: {parent: thigh, child: shin}\n"
+                        "    loop: {fixed: true, parent: shin, child: body}\n")
+            .find("its parents come back round to it (a cycle)") != std::string::npos);
+  // A zero axis.
+  CHECK(error_of(head +
+                 "    hip: {parent: body, child: thigh, axis: [0, 0, 0]}\n    knee: {parent: thigh, child: shin}\n") ==
+        "bad.yaml:11:5: hip: its axis is 0 0 0: it turns about nothing");
+  // A profile joint without a place, a placed joint without a servo, a link turned twice.
+  CHECK(error_of(head + "    hip: {parent: body, child: thigh}\n") ==
+        "bad.yaml:6:3: kinematics: knee: the profile's joint has no place in the body");
+  CHECK(error_of(head + "    hip: {parent: body, child: thigh}\n    knee: {parent: thigh, child: shin}\n"
+                        "    ankle: {parent: shin, child: body}\n")
+            .find("ankle: no joint of the profile is called so") != std::string::npos);
+  CHECK(error_of(head + "    hip: {parent: body, child: thigh}\n    knee: {parent: body, child: thigh}\n") ==
+        "bad.yaml:12:5: knee: the link 'thigh' is already turned by hip");
+  // Two roots: a link no joint turns besides the body.
+  CHECK(error_of("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\nkinematics:\n  links:\n    b: {sphere: 1}\n"
+                 "    c: {sphere: 1}\n    spare: {sphere: 1}\n  joints:\n    a: {parent: b, child: c}\n")
+            .find("2 links are no joint's child: the body is in pieces") != std::string::npos);
+  // Shapes: a bad size, two kinds at once, an unknown key.
+  CHECK(
+      error_of("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\nkinematics:\n  links:\n    b: {box: [1, 0, 1]}\n"
+               "    c: []\n  joints:\n    a: {parent: b, child: c}\n") ==
+      "bad.yaml:6:5: b: a shape's sizes must be more than 0 mm");
+  CHECK(
+      error_of("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\nkinematics:\n  links:\n    b: {box: [1, 1, 1], "
+               "sphere: 2}\n  joints:\n    a: {parent: b, child: b}\n") ==
+      "bad.yaml:6:8: b: a shape is exactly one of box, cylinder, sphere");
+  CHECK(error_of(head + "    hip: {parent: body, child: thigh, twist: 3}\n").find("unknown key 'twist'") !=
+        std::string::npos);
+}
+
+TEST_CASE("body: URDF in metres and radians, every joint with its limits", "[profile][body]") {
+  const auto m = open_profile("khr-3hv");
+  const auto u = to_urdf(m, {.prefix = "khr_"});
+  CHECK(u.find("<robot name=\"KHR_3HV\">") != std::string::npos);
+  CHECK(u.find("<joint name=\"khr_left_knee\" type=\"revolute\">") != std::string::npos);
+  // left_knee: -130..130 degrees, 65 mm below the hip pitch; the root is a link of its own.
+  CHECK(u.find("<origin xyz=\"0 0 -0.065\" rpy=\"0 0 0\"/>") != std::string::npos);
+  CHECK(u.find("<limit lower=\"-2.26893\" upper=\"2.26893\"") != std::string::npos);
+  CHECK(u.find("<link name=\"khr_pelvis\">") != std::string::npos);
+  std::size_t joints = 0;
+  for (auto at = u.find("type=\"revolute\""); at != std::string::npos; at = u.find("type=\"revolute\"", at + 1))
+    ++joints;
+  CHECK(joints == m.joints().size());
+  const auto bare = parse_profile("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\n", "t.yaml");
+  CHECK_THROWS_WITH(to_urdf(bare), Catch::Contains("has no kinematics"));
+}

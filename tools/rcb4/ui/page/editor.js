@@ -1,0 +1,432 @@
+// rcb4 ui: the motion editor. A motion is its steps as a motion file says them (the YAML the tool
+// reads and writes, docs/motions.md): poses with their times, counters and loops, branches, labels
+// and jumps, calls, speed/stretch, end. Edited here, checked and written by the server (the robot
+// services): pushed to a slot with its backup named, pulled from one, played from the host at the
+// authored timing, previewed in 3D without the robot, opened from and saved to a file.
+
+import { el, $, fmtDeg } from './dom.js';
+
+const KINDS = {
+  pose: () => null,  // made from the robot or the ghost
+  label: () => ({ label: 'again' }),
+  set_counter: () => ({ set_counter: 3 }),
+  loop: () => ({ loop: 'again' }),
+  if_buttons: () => ({ if_buttons: 'up', goto: 'again' }),
+  unless_buttons: () => ({ unless_buttons: 'up', goto: 'again' }),
+  if_ram: () => ({ if_ram: '0x0050', size: 2, at_least: 512, goto: 'again' }),
+  goto: () => ({ goto: 'again' }),
+  call: () => ({ call: 2 }),
+  speed: () => ({ speed: { all: 127 } }),
+  stretch: () => ({ stretch: { all: 127 } }),
+  end: () => 'end',
+};
+
+/** The kind of step @p s ("pose", "end", "if_buttons" …). */
+export function kindOf(s) {
+  if (s === 'end') return 'end';
+  for (const k of ['pose', 'label', 'set_counter', 'loop', 'count_down', 'if_buttons', 'unless_buttons', 'if_ram', 'goto',
+    'call', 'call_address', 'speed', 'stretch'])
+    if (s && typeof s === 'object' && k in s) return k;
+  return '?';
+}
+
+/** One line for step @p s. */
+export function describe(s) {
+  const k = kindOf(s);
+  if (k === 'pose') return `pose: ${Object.keys(s.pose).length} joints, ${s.time_ms} ms`;
+  if (k === 'end') return 'end';
+  if (k === 'label') return `label ${s.label}:`;
+  if (k === 'set_counter') return `counter = ${s.set_counter}`;
+  if (k === 'loop') return `loop to ${s.loop} while the counter is not 0`;
+  if (k === 'if_buttons') return `if ${s.if_buttons} held: go to ${s.goto}`;
+  if (k === 'unless_buttons') return `unless ${s.unless_buttons} held: go to ${s.goto}`;
+  if (k === 'if_ram') return `if RAM ${s.if_ram} … go to ${s.goto}`;
+  if (k === 'goto') return `go to ${s.goto}`;
+  if (k === 'call') return `call motion ${s.call}`;
+  return JSON.stringify(s);
+}
+
+/**
+ * The motion as the board plays it: [{from, to, ms, step}] segments of interpolation, counters and
+ * loops counted, no button held and every RAM value 0 (as a preview assumes), calls skipped; at
+ * most @p limitMs long. @p start: the joints before the first pose (degrees).
+ */
+export function segments(steps, start, limitMs = 120000) {
+  const labels = new Map();
+  steps.forEach((s, i) => { if (kindOf(s) === 'label') labels.set(s.label, i); });
+  const counters = new Map();
+  const out = [];
+  let cur = { ...start }, pc = 0, total = 0, quiet = 0;
+  const jump = (to) => { if (!labels.has(to)) throw new Error(`no label called ${to}`); pc = labels.get(to); };
+  while (pc < steps.length && total <= limitMs && quiet < 10000) {
+    const s = steps[pc], k = kindOf(s), at = pc;
+    pc += 1;
+    if (k === 'pose') {
+      const to = { ...cur, ...s.pose };
+      out.push({ from: cur, to, ms: s.time_ms, step: at });
+      cur = to;
+      total += s.time_ms;
+      quiet = 0;
+      continue;
+    }
+    quiet += 1;
+    if (k === 'end') break;
+    if (k === 'set_counter') counters.set(s.counter ?? 'c', s.set_counter & 255);
+    else if (k === 'loop' || k === 'count_down') {
+      const c = ((counters.get(s.counter ?? 'c') ?? 0) - 1) & 255;
+      counters.set(s.counter ?? 'c', c);
+      if ((c === 0) === (s.when === 'zero')) jump(s.loop ?? s.count_down);
+    } else if (k === 'unless_buttons' || k === 'goto') jump(s.goto);
+    else if (k === 'if_ram') {
+      const v = 0;
+      if (('equal' in s && v === s.equal) || ('not_equal' in s && v !== s.not_equal) || ('below' in s && v < s.below) ||
+        ('at_least' in s && v >= s.at_least)) jump(s.goto);
+    }
+  }
+  return out;
+}
+
+/** Joint angles at @p t ms into @p segs, each joint moving in a straight line as the board interpolates. */
+export function at(segs, t) {
+  let acc = 0;
+  for (const g of segs) {
+    if (t <= acc + g.ms) {
+      const f = g.ms ? Math.min(Math.max((t - acc) / g.ms, 0), 1) : 1;
+      const out = {};
+      for (const [k, v] of Object.entries(g.to)) {
+        const a = g.from[k];
+        out[k] = Number.isFinite(a) ? a + (v - a) * f : v;
+      }
+      return out;
+    }
+    acc += g.ms;
+  }
+  return segs.length ? segs[segs.length - 1].to : null;
+}
+
+export function createEditor(root, ctx) {
+  const h = ctx.hello;
+  const limits = new Map(h.joints.map((j) => [j.name, j]));
+  const ed = { doc: { robot: h.robot, name: '', period_ms: 10, steps: ['end'] }, sel: 0, undo: [], redo: [], preview: null };
+
+  // --- the parts of the panel ---
+  const name = el('input', { id: 'ed-name', placeholder: 'motion name (names its slot)', maxlength: 64, 'aria-label': 'motion name' });
+  const slot = el('input', { id: 'ed-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot number' });
+  const file = el('input', { id: 'ed-file', type: 'file', accept: '.yaml,.yml,.json', hidden: true });
+  const kind = el('select', { id: 'ed-kind', 'aria-label': 'kind of step to add' },
+    ...Object.keys(KINDS).map((k) => el('option', { value: k, text: k.replace('_', ' ') })));
+  const steps = el('ol', { id: 'ed-steps', class: 'steps', tabindex: 0, 'aria-label': 'the motion\'s steps: arrows select, Alt+arrows move, Delete removes, Ctrl+D duplicates, Ctrl+Z undoes' });
+  const jumps = document.createElementNS('http://www.w3.org/2000/svg', 'svg');
+  jumps.setAttribute('class', 'jumps');
+  const timeline = el('div', { id: 'ed-timeline', class: 'timeline', 'aria-label': 'the poses in time' });
+  const cursor = el('div', { class: 'cursor', hidden: true });
+  timeline.append(cursor);
+  const detail = el('div', { id: 'ed-detail', class: 'detail' });
+  const summary = el('div', { id: 'ed-summary', class: 'small muted' });
+  const bt = (id, text, title, fn, cls = '') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
+  root.replaceChildren(
+    el('div', { class: 'row' }, name,
+      bt('ed-new', 'New', 'an empty motion', () => load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] })),
+      bt('ed-open', 'Open…', 'a motion file (.yaml) from this computer', () => file.click()), file,
+      bt('ed-save', 'Save', 'download the motion as a motion file (.yaml), as rcb4 motion push reads it', save)),
+    el('div', { class: 'row' }, 'slot', slot,
+      bt('ed-pull', 'Pull', 'the slot into the editor', pull),
+      bt('ed-push', 'Push', 'write the motion into the slot (its old bytes are backed up first)', push, 'needs-control'),
+      bt('ed-preview', 'Preview', 'play it in 3D, at its timing, without the robot', preview),
+      bt('ed-play', 'Play on robot', 'play it from the host at its timing (the first pose is reached at the speed limit)', play, 'needs-control'),
+      bt('ed-stop', 'Stop', 'stop the preview and a play on the robot', stop)),
+    el('div', { class: 'row' }, kind,
+      bt('ed-add', 'Add', 'add a step of that kind after the selected one (a pose: the ghost\'s)', () => add(kind.value)),
+      bt('ed-capture', 'Capture', 'add the robot\'s measured pose (all joints, or the ticked ones of the selected pose)', capture),
+      bt('ed-dup', 'Duplicate', 'Ctrl+D', () => duplicate()),
+      bt('ed-del', 'Delete', 'Delete', () => remove()),
+      bt('ed-up', '↑', 'Alt+↑', () => move(-1)), bt('ed-down', '↓', 'Alt+↓', () => move(1)),
+      bt('ed-undo', 'Undo', 'Ctrl+Z', undo), bt('ed-redo', 'Redo', 'Ctrl+Y', redo)),
+    timeline, summary,
+    el('div', { class: 'steps-box' }, jumps, steps),
+    detail);
+
+  // --- history ---
+  const snapshot = () => JSON.stringify({ doc: ed.doc, sel: ed.sel });
+  const change = (fn) => {
+    ed.undo.push(snapshot());
+    if (ed.undo.length > 200) ed.undo.shift();
+    ed.redo = [];
+    fn();
+    render();
+  };
+  function undo() { if (!ed.undo.length) return; ed.redo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.undo.pop())); render(); }
+  function redo() { if (!ed.redo.length) return; ed.undo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.redo.pop())); render(); }
+
+  // --- steps ---
+  const clampSel = () => { ed.sel = Math.min(Math.max(ed.sel, 0), ed.doc.steps.length - 1); };
+  // A new step goes after the selected one; with the closing end selected, before it.
+  const insert = (s) => change(() => {
+    const last = ed.sel === ed.doc.steps.length - 1 && kindOf(ed.doc.steps[ed.sel]) === 'end';
+    const at = last ? ed.sel : ed.sel + 1;
+    ed.doc.steps.splice(at, 0, s);
+    ed.sel = at;
+  });
+  function poseAt(i) {  // the whole robot after step i: the measured angles, then every pose up to it
+    const out = { ...ctx.measured() };
+    for (let k = 0; k <= i && k < ed.doc.steps.length; k++) if (kindOf(ed.doc.steps[k]) === 'pose') Object.assign(out, ed.doc.steps[k].pose);
+    return out;
+  }
+  function add(k) {
+    if (k !== 'pose') return insert(KINDS[k]());
+    const from = poseAt(ed.sel), pose = {};
+    for (const j of h.joints) if (Number.isFinite(from[j.name])) pose[j.name] = Math.round(from[j.name] * 10) / 10;
+    insert({ pose, time_ms: 500 });
+  }
+  function capture() {
+    const m = ctx.measured(), cur = ed.doc.steps[ed.sel];
+    const only = kindOf(cur) === 'pose' ? Object.keys(cur.pose) : null;  // the ticked joints of the selected pose
+    const pose = {};
+    const outside = [];
+    for (const j of h.joints) {
+      if (only && !only.includes(j.name)) continue;
+      const a = m[j.name];
+      if (!Number.isFinite(a)) continue;
+      const v = Math.round(a * 10) / 10;
+      if (v < j.lower || v > j.upper) outside.push(j.name);
+      pose[j.name] = Math.min(Math.max(v, j.lower), j.upper);
+    }
+    if (!Object.keys(pose).length) return ctx.say('capture: no joint answers', 'error');
+    insert({ pose, time_ms: 500 });
+    ctx.say(`captured ${Object.keys(pose).length} joints` + (outside.length ? ` (at the limit: ${outside.join(', ')})` : ''));
+  }
+  function duplicate() { const s = ed.doc.steps[ed.sel]; if (s !== undefined) insert(JSON.parse(JSON.stringify(s))); }
+  function remove() {
+    if (ed.doc.steps.length <= 1) return;
+    change(() => { ed.doc.steps.splice(ed.sel, 1); clampSel(); });
+  }
+  function move(d) {
+    const i = ed.sel, j = i + d;
+    if (j < 0 || j >= ed.doc.steps.length) return;
+    change(() => { [ed.doc.steps[i], ed.doc.steps[j]] = [ed.doc.steps[j], ed.doc.steps[i]]; ed.sel = j; });
+  }
+  function reorder(from, to) {
+    if (from === to) return;
+    change(() => { const [s] = ed.doc.steps.splice(from, 1); ed.doc.steps.splice(to, 0, s); ed.sel = to; });
+  }
+
+  steps.addEventListener('keydown', (e) => {
+    const key = e.key, mod = e.ctrlKey || e.metaKey;
+    if (key === 'ArrowUp' || key === 'ArrowDown') {
+      const d = key === 'ArrowUp' ? -1 : 1;
+      if (e.altKey) move(d); else { ed.sel += d; clampSel(); render(); }
+    } else if (key === 'Delete') remove();
+    else if (mod && key.toLowerCase() === 'd') duplicate();
+    else if (mod && key.toLowerCase() === 'z') undo();
+    else if (mod && key.toLowerCase() === 'y') redo();
+    else return;
+    e.preventDefault();
+  });
+
+  // --- drawing ---
+  function render() {
+    clampSel();
+    name.value = ed.doc.name || '';
+    const segs = (() => { try { return segments(ed.doc.steps, ctx.measured()); } catch { return []; } })();
+    steps.replaceChildren(...ed.doc.steps.map((s, i) => {
+      const k = kindOf(s);
+      const bad = k === 'pose' && Object.entries(s.pose).some(([n, v]) => limits.has(n) && (v < limits.get(n).lower || v > limits.get(n).upper));
+      const li = el('li', { class: `step ${k}` + (i === ed.sel ? ' selected' : '') + (bad ? ' beyond' : ''), draggable: 'true', 'data-step': i },
+        el('span', { class: 'n', text: String(i + 1) }), el('span', { text: describe(s) }));
+      li.addEventListener('click', () => { ed.sel = i; render(); });
+      li.addEventListener('dragstart', (e) => { e.dataTransfer.setData('text/plain', String(i)); });
+      li.addEventListener('dragover', (e) => e.preventDefault());
+      li.addEventListener('drop', (e) => { e.preventDefault(); reorder(Number(e.dataTransfer.getData('text/plain')), i); });
+      return li;
+    }));
+    drawJumps();
+    // The timeline: each pose a block as long as its time (one pass).
+    const poses = ed.doc.steps.map((s, i) => [s, i]).filter(([s]) => kindOf(s) === 'pose');
+    const total = poses.reduce((a, [s]) => a + s.time_ms, 0) || 1;
+    timeline.replaceChildren(cursor, ...poses.map(([s, i]) => {
+      const b = el('div', { class: 'block' + (i === ed.sel ? ' selected' : ''), title: `step ${i + 1}: ${s.time_ms} ms`, text: String(i + 1) });
+      b.style.flexGrow = String(Math.max(s.time_ms, 1) / total);
+      b.addEventListener('click', () => { ed.sel = i; render(); });
+      return b;
+    }));
+    const played = segs.reduce((a, g) => a + g.ms, 0);
+    summary.textContent = `${ed.doc.steps.length} steps, ${poses.length} poses; plays ${(played / 1000).toFixed(2)} s` +
+      ' as the board would (loops counted, no button held)';
+    renderDetail();
+    ctx.view?.setGhost(poseAt(ed.sel));
+    ctx.controls();
+  }
+
+  function drawJumps() {
+    const rows = [...steps.children];
+    const labels = new Map();
+    ed.doc.steps.forEach((s, i) => { if (kindOf(s) === 'label') labels.set(s.label, i); });
+    jumps.replaceChildren();
+    const h0 = steps.offsetTop;
+    jumps.setAttribute('height', String(steps.offsetHeight + 4));
+    ed.doc.steps.forEach((s, i) => {
+      const to = s.goto ?? s.loop ?? s.count_down;
+      if (typeof to !== 'string' || !labels.has(to) || !rows[i]) return;
+      const y1 = rows[i].offsetTop - h0 + rows[i].offsetHeight / 2, y2 = rows[labels.get(to)].offsetTop - h0 + rows[labels.get(to)].offsetHeight / 2;
+      const bend = 8 + Math.min(Math.abs(y2 - y1) / 6, 18);
+      const p = document.createElementNS('http://www.w3.org/2000/svg', 'path');
+      p.setAttribute('d', `M 34 ${y1} C ${34 - bend} ${y1}, ${34 - bend} ${y2}, 34 ${y2}`);
+      p.setAttribute('class', 'jump');
+      jumps.append(p);
+    });
+  }
+
+  function renderDetail() {
+    const s = ed.doc.steps[ed.sel];
+    if (kindOf(s) !== 'pose') {
+      const text = el('input', { id: 'ed-step-text', value: JSON.stringify(s), 'aria-label': 'the step as a motion file says it (JSON)' });
+      const apply = el('button', { type: 'button', id: 'ed-step-apply' }, 'Apply');
+      apply.addEventListener('click', () => {
+        let v;
+        try { v = JSON.parse(text.value); } catch { return ctx.say('the step is not JSON', 'error'); }
+        change(() => { ed.doc.steps[ed.sel] = v; });
+      });
+      detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), el('div', { class: 'row' }, text, apply));
+      return;
+    }
+    const time = el('input', { id: 'ed-time', type: 'number', min: 0, max: 6375, step: 10, value: s.time_ms, 'aria-label': 'time of the pose in ms' });
+    time.addEventListener('change', () => {
+      const v = Math.round(Number(time.value));
+      if (!(v >= 0 && v <= 6375)) { time.classList.add('beyond'); return ctx.say('a pose takes 0 to 6375 ms', 'error'); }
+      change(() => { s.time_ms = v; });
+    });
+    const live = el('input', { id: 'ed-live', type: 'checkbox', class: 'needs-control' });
+    live.checked = !!ed.live;
+    live.addEventListener('change', () => { ed.live = live.checked; if (ed.live) sendLive(s.pose); });
+    const rows = h.joints.map((j) => {
+      const on = j.name in s.pose;
+      const v = on ? s.pose[j.name] : poseAt(ed.sel - 1)[j.name] ?? 0;
+      const tick = el('input', { type: 'checkbox', 'aria-label': `${j.name} in this pose` });
+      tick.checked = on;
+      const slider = el('input', { type: 'range', min: j.lower, max: j.upper, step: 0.5, value: v, disabled: !on, 'aria-label': `${j.name} degrees` });
+      const num = el('input', { type: 'number', step: 0.5, value: Math.round(v * 10) / 10, disabled: !on, 'aria-label': `${j.name} degrees, typed` });
+      const row = el('div', { class: 'pose-joint' + (on && (v < j.lower || v > j.upper) ? ' beyond' : ''), 'data-joint': j.name },
+        tick, el('span', { class: 'name', text: j.name }), slider, num);
+      tick.addEventListener('change', () => change(() => { if (tick.checked) s.pose[j.name] = Number(num.value) || 0; else delete s.pose[j.name]; }));
+      const set = (x, commit) => {
+        if (!(x >= j.lower && x <= j.upper)) {  // refused: said, shown red a moment, the kept value back
+          row.classList.add('beyond');
+          ctx.say(`${j.name}: ${x}° is beyond its limits ${j.lower}..${j.upper}: not taken`, 'error');
+          setTimeout(() => { num.value = s.pose[j.name]; row.classList.remove('beyond'); }, 1500);
+          return;
+        }
+        row.classList.remove('beyond');
+        if (commit) change(() => { s.pose[j.name] = x; }); else { s.pose[j.name] = x; ctx.view?.setGhost(poseAt(ed.sel)); }
+        if (ed.live) sendLive({ [j.name]: x });
+      };
+      slider.addEventListener('input', () => { num.value = slider.value; set(Number(slider.value), false); });
+      slider.addEventListener('change', () => { ed.undo.push(snapshot()); render(); });
+      num.addEventListener('change', () => set(Number(num.value), true));
+      return row;
+    });
+    detail.replaceChildren(el('div', { class: 'row small' }, `step ${ed.sel + 1}: pose over`, time, 'ms',
+      el('label', { class: 'small' }, live, ' live on the robot')), el('div', { class: 'pose-joints' }, ...rows));
+    ctx.controls();
+  }
+
+  // Live editing moves the robot through the server (its speed limit, its limits, its move rule).
+  function sendLive(joints) { if (ctx.controlling()) ctx.send({ op: 'move', joints }); }
+
+  // --- files and slots ---
+  const text = () => JSON.stringify({ ...ed.doc, name: name.value.trim() || undefined, robot: h.robot });
+  name.addEventListener('change', () => change(() => { ed.doc.name = name.value.trim(); }));
+  function load(doc) {
+    ed.undo.push(snapshot());
+    ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: doc.steps?.length ? doc.steps : ['end'] };
+    ed.sel = 0;
+    render();
+  }
+  async function pull() {
+    try {
+      const r = await ctx.request({ op: 'motion_pull', slot: Number(slot.value) });
+      load(r.motion);
+      ctx.say(`motion ${r.slot} in the editor (${r.plays})` + (r.problem ? `; as it is, it would not push back: ${r.problem}` : ''));
+    } catch (e) { ctx.say(e.message, 'error'); }
+  }
+  async function push() {
+    try {
+      const r = await ctx.request({ op: 'motion_push', slot: Number(slot.value), text: text() });
+      const notes = r.notes?.length ? ` (${r.notes.join('; ')})` : '';
+      ctx.say(r.unchanged ? `motion ${r.slot} already holds these ${r.bytes} bytes: nothing written${notes}`
+        : `wrote ${r.bytes} bytes to motion ${r.slot}: ${r.summary}; the old bytes are in ${r.backup}${notes}`);
+      $('#ed-result').textContent = r.unchanged ? '' : `backup: ${r.backup}`;
+      ctx.refresh();
+    } catch (e) { ctx.say(e.message, 'error'); }
+  }
+  async function save() {
+    try {
+      const r = await ctx.request({ op: 'motion_check', text: text() });
+      const a = el('a', { href: URL.createObjectURL(new Blob([r.yaml], { type: 'application/yaml' })), download: (name.value.trim() || 'motion').replace(/[^A-Za-z0-9_-]+/g, '_') + '.yaml' });
+      a.click();
+      setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+      ctx.say(r.problem ? `saved, but as it is it would not play: ${r.problem}` : `saved (${r.plays})`, r.problem ? 'error' : 'note');
+    } catch (e) { ctx.say(e.message, 'error'); }
+  }
+  file.addEventListener('change', async () => {
+    const f = file.files[0];
+    if (!f) return;
+    try {
+      const r = await ctx.request({ op: 'motion_check', text: await f.text() });
+      load(r.motion);
+      ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}`, r.problem ? 'error' : 'note');
+    } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
+    file.value = '';
+  });
+
+  // --- preview, play, stop ---
+  function preview() {
+    stop();
+    let segs;
+    try { segs = segments(ed.doc.steps, ctx.measured()); } catch (e) { return ctx.say(`preview: ${e.message}`, 'error'); }
+    const total = segs.reduce((a, g) => a + g.ms, 0);
+    const t0 = performance.now();
+    cursor.hidden = false;
+    $('#ed-result').textContent = 'previewing…';
+    const tick = () => {
+      const t = performance.now() - t0;
+      ctx.view?.setGhost(at(segs, Math.min(t, total)));
+      cursor.style.left = `${Math.min(t / Math.max(total, 1), 1) * 100}%`;
+      if (t < total && ed.preview) ed.preview = requestAnimationFrame(tick);
+      else {
+        ed.preview = null;
+        cursor.hidden = true;
+        $('#ed-result').textContent = `preview: ${(total / 1000).toFixed(2)} s of motion, shown in ${(t / 1000).toFixed(2)} s`;
+      }
+    };
+    ed.preview = requestAnimationFrame(tick);
+  }
+  async function play() {
+    stop();
+    const first = ed.doc.steps.find((s) => kindOf(s) === 'pose');
+    try {
+      if (first) {  // into the first pose at the speed limit; from there, the authored timing
+        const r = await ctx.request({ op: 'move', joints: first.pose });
+        await new Promise((done) => setTimeout(done, (r.ms ?? 0) + 50));
+      }
+      await ctx.request({ op: 'play_motion', text: text() });
+      ed.playing = true;
+      ctx.say('playing on the robot from the host');
+    } catch (e) { ctx.say(e.message, 'error'); }
+  }
+  function stop() {
+    if (ed.preview) { cancelAnimationFrame(ed.preview); ed.preview = null; cursor.hidden = true; }
+    if (ed.playing && ctx.controlling()) ctx.send({ op: 'stop' });  // the play from the host, and a ROM motion it called
+    ed.playing = false;
+    ctx.view?.setGhost(poseAt(ed.sel));
+  }
+  root.append(el('div', { id: 'ed-result', class: 'small muted' }));
+
+  render();
+  return {
+    load, render,
+    get doc() { return ed.doc; },
+    /** A motion played from the host ended (the server's "played"). */
+    played(m) { ed.playing = false; ctx.say(m.error ? `the play stopped: ${m.error}` : `played ${m.poses} poses in ${m.seconds} s`, m.error ? 'error' : 'note'); },
+    stop,
+  };
+}

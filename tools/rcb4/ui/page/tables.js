@@ -1,0 +1,144 @@
+// rcb4 ui: the rest of HeartToHeart4's window: the 120 motion slots (play, stop, resume, pull into
+// the editor, erase), the remote's buttons (a button assigned by clicking the remote's picture,
+// cleared, pressed and held to test a branch), trims (live, kept in ROM on request), the ROM backup.
+// Every change goes through the server's robot services, with their checks and refusals.
+
+import { el } from './dom.js';
+
+// The KRR remote's buttons (motion/buttons.hpp), laid out as on the pad: [name, column, row].
+const PAD = [['s1', 0, 0], ['s2', 1, 0], ['s3', 5, 0], ['s4', 6, 0],
+  ['up', 1, 1], ['triangle', 5, 1], ['left', 0, 2], ['right', 2, 2], ['square', 4, 2], ['circle', 6, 2],
+  ['down', 1, 3], ['cross', 5, 3]];
+const SYMBOL = { up: '▲', down: '▼', left: '◀', right: '▶', triangle: '△', circle: '○', cross: '✕', square: '□' };
+
+export function createTables(root, ctx) {
+  const tbody = el('tbody', { id: 'slots' });
+  const chosen = new Set();
+  const pad = el('div', { class: 'pad', id: 'remote', role: 'group', 'aria-label': 'the remote: click buttons to choose a combination' });
+  for (const [b, c, r] of PAD) {
+    const k = el('button', { type: 'button', class: 'key', 'data-button': b, 'aria-pressed': 'false', title: b, text: SYMBOL[b] ?? b.toUpperCase() });
+    k.style.gridColumn = String(c + 1);
+    k.style.gridRow = String(r + 1);
+    k.addEventListener('click', () => { if (chosen.has(b)) chosen.delete(b); else chosen.add(b); paintPad(); });
+    pad.append(k);
+  }
+  const combo = el('span', { id: 'combo', class: 'combo' });
+  const bslot = el('input', { id: 'button-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot the buttons play' });
+  const entries = el('ul', { id: 'button-entries', class: 'list' });
+  const trims = el('div', { id: 'trims', class: 'trims' });
+  const persist = el('button', { id: 'trims-persist', type: 'button', class: 'needs-control', title: 'write the trims shown into ROM, which the board loads at power-on' }, 'Keep in ROM');
+  const bt = (id, text, title, fn, cls = 'needs-control') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
+  root.replaceChildren(
+    el('details', { open: true, id: 'slots-panel' }, el('summary', {}, 'Motion slots'),
+      el('div', { class: 'row' }, bt('slots-refresh', 'Refresh', 'read the 120 slots again', () => list(), ''),
+        bt('motion-resume', 'Resume', 'let a motion stopped part way go on', () => ask({ op: 'motion_resume' }, 'the ROM program runs again'))),
+      el('div', { class: 'slots-box' }, el('table', { class: 'slots' },
+        el('thead', {}, el('tr', {}, ...['slot', 'name', 'bytes', 's', ''].map((t) => el('th', { text: t })))), tbody))),
+    el('details', { id: 'buttons-panel' }, el('summary', {}, 'Remote buttons'), pad,
+      el('div', { class: 'row' }, combo),
+      el('div', { class: 'row' }, 'play slot', bslot,
+        bt('button-set', 'Assign', 'these buttons play the slot (ROM and RAM)', () => withCombo((b) => ask({ op: 'button_set', buttons: b, slot: Number(bslot.value) }, null, showEntries))),
+        bt('button-clear', 'Clear', 'these buttons play nothing any more', () => withCombo((b) => ask({ op: 'button_clear', buttons: b }, null, showEntries)))),
+      el('div', { class: 'row' },
+        bt('button-press', 'Press', 'press them as the receiver would, until a motion starts', () => withCombo((b) => ask({ op: 'button_press', buttons: b }, `${b} pressed`))),
+        bt('button-hold', 'Hold', 'keep them pressed (a motion\'s if_buttons sees them)', () => withCombo((b) => ask({ op: 'button_press', buttons: b, hold: true }, `${b} held`))),
+        bt('button-release', 'Release', 'release every button', () => ask({ op: 'button_release' }, 'buttons released'))),
+      entries),
+    el('details', { id: 'trims-panel' }, el('summary', {}, 'Trims'),
+      el('div', { class: 'small muted', text: 'a trim corrects a servo horn\'s mounting (±30°): set live, kept in ROM on request' }),
+      trims, el('div', { class: 'row' }, bt('trims-refresh', 'Read', 'read the trims again', () => readTrims(), ''), persist)),
+    el('details', { id: 'rom-panel' }, el('summary', {}, 'ROM'),
+      el('div', { class: 'row' }, bt('rom-backup', 'Back up the ROM', 'download the whole ROM (256 KiB) with its CRC-32', backup)),
+      el('div', { class: 'small muted', text: 'restore a backup with: rcb4 rom restore FILE (checked, the replaced ROM saved first)' })));
+
+  function paintPad() {
+    for (const k of pad.children) k.setAttribute('aria-pressed', String(chosen.has(k.dataset.button)));
+    combo.textContent = chosen.size ? [...chosen].join('+') : 'click the remote\'s buttons';
+  }
+  const withCombo = (fn) => (chosen.size ? fn([...chosen].join('+')) : ctx.say('choose the buttons on the remote first', 'error'));
+  async function ask(msg, done, then) {
+    try {
+      const r = await ctx.request(msg);
+      if (done) ctx.say(done);
+      then?.(r);
+      return r;
+    } catch (e) { ctx.say(e.message, 'error'); return null; }
+  }
+
+  // --- the 120 slots ---
+  let slots = [];
+  async function list() {
+    const r = await ask({ op: 'motion_list' });
+    if (!r) return;
+    slots = r.slots;
+    tbody.replaceChildren(...slots.map((s) => el('tr', { 'data-slot': s.slot, class: (s.used ? 'used' : 'free') + (s.broken ? ' broken' : '') },
+      el('td', { text: String(s.slot) }),
+      el('td', { text: s.used ? (s.name || '') + (s.broken ? ' (broken)' : '') : 'free' }),
+      el('td', { text: s.used ? String(s.bytes) : '' }),
+      el('td', { text: s.used ? (s.endless ? '∞' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
+      el('td', {}, ...(s.used ? [
+        bt('', '▶', 'play', () => ask({ op: 'motion_play', slot: s.slot }, `playing motion ${s.slot}`)),
+        bt('', '■', 'stop', () => ask({ op: 'motion_stop' }, 'motion stopped')),
+        bt('', '✎', 'pull into the editor', () => ctx.edit(s.slot), ''),
+        bt('', '✕', 'erase (its bytes backed up first)', () => ask({ op: 'motion_erase', slot: s.slot }, null, (x) => { ctx.say(`motion ${s.slot} erased; its bytes are in ${x.backup}`); list(); })),
+      ] : [])))));
+    ctx.controls();
+  }
+
+  // --- buttons ---
+  function showEntries(r) {
+    if (r.done) ctx.say(r.done);
+    const row = (e, where) => el('li', {}, el('span', { text: `${e.buttons ?? '(not buttons)'} → ${e.slot ? `motion ${e.slot}${e.name ? ` (${e.name})` : ''}` : '0x' + e.address.toString(16)}` }), el('span', { class: 'small muted', text: where }));
+    const list = r.entries ? r.entries.map((e) => row(e, 'RAM and ROM'))
+      : [...r.ram.map((e) => row(e, r.same ? 'RAM and ROM' : 'RAM')), ...(r.same ? [] : r.rom.map((e) => row(e, 'ROM')))];
+    entries.replaceChildren(...list);
+    if (!list.length) entries.append(el('li', { class: 'muted', text: 'no button plays anything' }));
+    if (r.rom_program === false) entries.append(el('li', { class: 'error', text: 'the ROM program is off: no button plays anything until it runs (Resume)' }));
+  }
+  const readButtons = () => ask({ op: 'buttons' }, null, showEntries);
+
+  // --- trims ---
+  async function readTrims() {
+    const r = await ask({ op: 'trims' });
+    if (!r) return;
+    trims.replaceChildren(...r.trims.filter((t) => t.allocated).map((t) => {
+      const n = el('input', { type: 'number', min: -30, max: 30, step: 0.1, value: t.degrees, 'data-joint': t.name, class: 'needs-control', 'aria-label': `${t.name} trim in degrees` });
+      n.addEventListener('change', () => {
+        const v = Number(n.value);
+        if (!(v >= -30 && v <= 30)) { n.classList.add('beyond'); return ctx.say(`${t.name}: a trim is within ±30°`, 'error'); }
+        n.classList.remove('beyond');
+        ask({ op: 'trim_set', joints: { [t.name]: v } }, `${t.name} trim ${v}° (RAM)`);
+      });
+      return el('div', { class: 'trim' }, el('span', { text: t.name }), n,
+        el('span', { class: 'small muted', text: t.rom_degrees === null ? 'ROM –' : t.rom_degrees === t.degrees ? 'in ROM' : `ROM ${t.rom_degrees}` }));
+    }));
+    ctx.controls();
+  }
+  persist.addEventListener('click', async () => {
+    const joints = {};
+    for (const n of trims.querySelectorAll('input[data-joint]')) joints[n.dataset.joint] = Number(n.value);
+    if (await ask({ op: 'trim_set', joints, persist: true }, 'trims kept in ROM (the board loads them at power-on)')) readTrims();
+  });
+
+  // --- ROM ---
+  async function backup() {
+    ctx.say('reading the whole ROM…');
+    const r = await ask({ op: 'rom_backup' });
+    if (!r) return;
+    const bytes = Uint8Array.from(atob(r.base64), (c) => c.charCodeAt(0));
+    const a = el('a', { href: URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' })), download: r.file });
+    a.click();
+    setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+    ctx.say(`ROM backed up: ${r.bytes} bytes, CRC-32 ${r.crc32} (${r.file})`);
+  }
+
+  paintPad();
+  root.querySelector('#buttons-panel').addEventListener('toggle', (e) => { if (e.target.open) readButtons(); });
+  root.querySelector('#trims-panel').addEventListener('toggle', (e) => { if (e.target.open) readTrims(); });
+  return {
+    list, readTrims, readButtons,
+    /** The running slot, from the state. */
+    running(slot) { for (const tr of tbody.children) tr.classList.toggle('running', String(slot) === tr.dataset.slot); },
+    get slots() { return slots; },
+  };
+}

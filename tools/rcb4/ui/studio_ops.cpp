@@ -1,0 +1,322 @@
+// rcb4 ui: the studio's ops on the board (see studio_ops.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include "studio_ops.hpp"
+
+#include <rcb4/motion/buttons.hpp>
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/ops/layout.hpp>
+#include <rcb4/robot/motion_file.hpp>
+#include <rcb4/robot/services/buttons.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
+#include <rcb4/robot/services/rom.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
+#include <rcb4/robot/services/trims.hpp>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+
+namespace cli::ui {
+namespace {
+
+namespace sv = rcb4::robot::services;
+namespace robot = rcb4::robot;
+namespace mo = rcb4::motion;
+
+/** The page's words for a service's refusal: what, and what to do. */
+std::string words(const sv::refused& e) {
+  return e.hint.empty() ? std::string(e.what()) : std::string(e.what()) + " (" + e.hint + ")";
+}
+
+std::string base64(std::span<const std::uint8_t> b) {
+  static constexpr char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((b.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < b.size(); i += 3) {
+    const unsigned v = (b[i] << 16u) | (i + 1 < b.size() ? b[i + 1] << 8u : 0u) | (i + 2 < b.size() ? b[i + 2] : 0u);
+    out += digits[(v >> 18) & 63];
+    out += digits[(v >> 12) & 63];
+    out += i + 1 < b.size() ? digits[(v >> 6) & 63] : '=';
+    out += i + 2 < b.size() ? digits[v & 63] : '=';
+  }
+  return out;
+}
+
+std::uint16_t button_word(const std::string& text) {
+  const auto b = mo::parse_buttons(text);
+  if (!mo::ok(b)) throw studio_refusal("buttons: " + std::get<mo::failure>(b).message);
+  return std::get<std::uint16_t>(b);
+}
+
+json entries_json(const std::vector<rcb4::vector_entry>& entries, const rcb4::rom_layout& layout,
+                  const robot::model& m) {
+  json out = json::array();
+  for (const auto& e : entries) {
+    const auto b = e.buttons();
+    const std::uint32_t a = e.target.value(), base = layout.motion_base.value();
+    const bool slot =
+        a >= base && (a - base) % layout.slot_size == 0 && (a - base) / layout.slot_size < layout.motion_count;
+    const unsigned n = slot ? (a - base) / layout.slot_size + 1 : 0;
+    out.push_back({{"buttons", b ? json(mo::buttons_text(*b)) : json(nullptr)},
+                   {"word", b ? json(*b) : json(nullptr)},
+                   {"slot", slot ? json(n) : json(nullptr)},
+                   {"name", slot ? json(sv::slot_name(m, n)) : json(nullptr)},
+                   {"address", a}});
+  }
+  return out;
+}
+
+}  // namespace
+
+studio_ops::studio_ops(session& s, const robot::model& m, const loop_options& o)
+    : s_(s), m_(m), o_(o), link_(s, true) {}
+
+studio_ops::~studio_ops() {
+  try {
+    stop();
+  } catch (...) {  // the loop is ending: the board may be gone
+  }
+}
+
+json studio_ops::act(const studio_action& a, client_id from) {
+  const auto args = json::parse(a.args, nullptr, false);
+  const auto slot = [&] { return args.at("slot").get<unsigned>(); };
+  const auto backup = [&](unsigned n, std::span<const std::uint8_t> old) {
+    const auto dir = o_.poses / "backups";
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    return sv::save_backup_file(n, old, (dir / fmt::format("motion-{}-{}.bin", n, sv::file_stamp())).string());
+  };
+  try {
+    const auto& op = a.op;
+    if (op == "motion_list") return list();
+    if (op == "motion_pull") return pull(slot());
+    if (op == "motion_check") return check(args.at("text").get<std::string>());
+    if (op == "motion_push") return push(slot(), args.at("text").get<std::string>(), args.value("dry_run", false));
+    if (op == "motion_erase") {
+      const auto r = sv::erase_motion(link_, *o_.layout, slot(), backup, m_.name());
+      return json{{"slot", r.motion}, {"unchanged", r.unchanged}, {"backup", r.backup}};
+    }
+    if (op == "motion_resume") {
+      sv::run(link_, rcb4::ops::resume_motion());
+      return json::object();
+    }
+    if (op == "play_motion") return play(args.at("text").get<std::string>(), from);
+    if (op == "buttons") return buttons();
+    if (op == "button_set" || op == "button_clear") {
+      const auto word = button_word(args.at("buttons").get<std::string>());
+      const auto r =
+          op == "button_set" ? sv::set_button(link_, *o_.layout, word, slot()) : sv::clear_button(link_, word);
+      return json{{"done", r.done}, {"entries", entries_json(r.entries, *o_.layout, m_)}};
+    }
+    if (op == "button_press") {
+      const auto r =
+          sv::press(link_, *o_.layout, button_word(args.at("buttons").get<std::string>()), args.value("hold", false));
+      return json{{"entry", r.entry},
+                  {"held", r.held},
+                  {"slot", r.state.motion ? json(*r.state.motion) : json(nullptr)},
+                  {"running", r.state.running}};
+    }
+    if (op == "button_release") {
+      sv::release(link_);
+      return json::object();
+    }
+    if (op == "trims") return trims();
+    if (op == "trim_set") {
+      std::vector<std::pair<std::string, double>> items;
+      for (const auto& [k, v] : args.at("joints").items()) items.emplace_back(k, v.get<double>());
+      const auto r = sv::set_trims(link_, m_, items, args.value("persist", false));
+      json written = json::object();
+      for (const auto& t : r.written) written[t.j->name] = t.counts;
+      return json{{"written", written}, {"persist", r.persistent}};
+    }
+    if (op == "hand") return hand(args.at("joint").get<std::string>(), args.at("degrees").get<double>());
+    if (op == "rom_backup") return rom_backup();
+    throw studio_refusal("unknown studio op " + op);
+  } catch (const sv::refused& e) {
+    throw studio_refusal(words(e));
+  } catch (const robot::profile_error& e) {
+    throw studio_refusal(std::string(plain_message(e.what())));
+  } catch (const std::system_error& e) {
+    const auto f = explain(e.code(), a.op);
+    throw studio_refusal(
+        fmt::format("{}: {}{}", a.op, plain_message(e.what()), f.hint.empty() ? "" : " (" + f.hint + ")"));
+  } catch (const json::exception& e) {  // the fields were checked by the parser: a slip of ours
+    throw studio_refusal(a.op + ": " + e.what());
+  }
+}
+
+json studio_ops::list() {
+  const auto& layout = *o_.layout;
+  const auto used = s_.run(rcb4::ops::list_motions(layout));
+  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  const auto names = sv::load_slot_names(m_.name());
+  json slots = json::array();
+  for (unsigned n = 1; n <= layout.motion_count; ++n) {
+    json e{{"slot", n}, {"name", sv::slot_name(m_, n, names)}};
+    const auto it = std::find_if(used.begin(), used.end(), [&](const auto& v) { return v.number == n; });
+    e["used"] = it != used.end();
+    if (it != used.end()) {
+      e["bytes"] = it->size;
+      e["commands"] = it->frames;
+      e["broken"] = !it->ends || !it->readable;
+      e["seconds"] = nullptr;
+      if (it->ends) {
+        const mo::slot where{rcb4::rom_address::make(it->address).value(), layout.slot_size};
+        if (auto p = mo::lift(mo::disassemble(it->code, where)); mo::ok(p)) {
+          const auto t = mo::play_time(std::get<mo::program>(p));
+          e["endless"] = t.endless;
+          if (!t.endless && t.error.empty())
+            e["seconds"] = std::round(static_cast<double>(t.frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
+        }
+      }
+    }
+    slots.push_back(std::move(e));
+  }
+  return json{{"slots", slots}, {"layout", layout.name}};
+}
+
+json studio_ops::pull(unsigned slot) {
+  const auto r = sv::pull_motion(link_, m_, *o_.layout, slot);
+  return json{{"slot", slot},
+              {"name", r.document.name},
+              {"motion", json::parse(robot::motion_json(r.document))},
+              {"yaml", robot::motion_yaml(r.document, fmt::format("motion {} of the board, pulled by rcb4 ui", slot))},
+              {"plays", r.plays},
+              {"problem", r.beyond.empty() ? json(nullptr) : json(r.beyond)}};
+}
+
+json studio_ops::check(const std::string& text) {
+  const auto d = robot::parse_motion(text, "the motion", m_);
+  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  const auto c = robot::to_program(d, m_, *o_.layout, period, true);
+  json out{{"motion", json::parse(robot::motion_json(d))}, {"yaml", robot::motion_yaml(d)}};
+  if (!robot::ok(c)) {
+    out["problem"] = std::get<robot::problem>(c).message;
+    return out;
+  }
+  const auto& cm = std::get<robot::compiled_motion>(c);
+  out["problem"] = nullptr;
+  out["notes"] = cm.notes;
+  out["plays"] = sv::play_time_text(mo::play_time(cm.program), cm.period);
+  const auto code = mo::assemble(cm.program, mo::slot_of(*o_.layout, 1).value());
+  out["bytes"] = mo::ok(code) ? json(std::get<std::vector<std::uint8_t>>(code).size()) : json(nullptr);
+  return out;
+}
+
+json studio_ops::push(unsigned slot, const std::string& text, bool dry_run) {
+  sv::push_source src;
+  src.document = robot::parse_motion(text, "the motion", m_);
+  src.name = "the motion";
+  src.rescale = true;  // the editor's times are milliseconds, whatever the board's period
+  const auto r = sv::push_motion(
+      link_, m_, *o_.layout, slot, src,
+      [&](unsigned n, std::span<const std::uint8_t> old) {
+        const auto dir = o_.poses / "backups";
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        return sv::save_backup_file(n, old, (dir / fmt::format("motion-{}-{}.bin", n, sv::file_stamp())).string());
+      },
+      dry_run);
+  return json{{"slot", r.motion},         {"address", r.address}, {"bytes", r.bytes.size()},
+              {"unchanged", r.unchanged}, {"dry_run", r.dry_run}, {"backup", r.backup},
+              {"summary", r.summary},     {"notes", r.notes},     {"name", r.name}};
+}
+
+json studio_ops::play(const std::string& text, client_id from) {
+  if (play_) throw studio_refusal("a motion already plays from the host: Stop it first");
+  const auto d = robot::parse_motion(text, "the motion", m_);
+  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  play_ = std::make_unique<sv::host_play>(link_, m_, *o_.layout, period, d, "the motion", true);
+  play_start_ = clock::now();
+  play_from_ = from;
+  play_name_ = d.name.empty() ? "the motion" : d.name;
+  try {
+    const auto next = play_->advance(std::chrono::milliseconds(0));
+    play_next_ = next ? std::optional(play_start_ + *next) : std::nullopt;
+  } catch (...) {
+    play_.reset();
+    throw;
+  }
+  return json{{"playing", true}, {"notes", play_->notes()}};
+}
+
+std::optional<clock::time_point> studio_ops::due() const {
+  if (!play_) return std::nullopt;
+  return play_next_.value_or(clock::now());
+}
+
+std::optional<letter> studio_ops::tick() {
+  if (!play_ || (play_next_ && clock::now() < *play_next_)) return std::nullopt;
+  json j{{"type", "played"}, {"name", play_name_}};
+  try {
+    if (play_next_) {
+      const auto now = std::chrono::duration_cast<std::chrono::milliseconds>(clock::now() - play_start_);
+      const auto next = play_->advance(now);
+      if (next) {
+        play_next_ = play_start_ + *next;
+        return std::nullopt;
+      }
+    }
+    j["poses"] = play_->poses();
+    j["seconds"] = std::round(std::chrono::duration<double>(clock::now() - play_start_).count() * 100) / 100;
+    j["error"] = nullptr;
+  } catch (const sv::refused& e) {
+    j["error"] = words(e);
+  } catch (const std::system_error& e) {
+    j["error"] = std::string("the board stopped answering: ") + std::string(plain_message(e.what()));
+  }
+  play_.reset();
+  return letter{play_from_, j.dump()};
+}
+
+void studio_ops::stop() {
+  if (!play_) return;
+  auto p = std::move(play_);
+  play_next_.reset();
+  p->stop();
+}
+
+json studio_ops::buttons() {
+  const auto t = sv::read_buttons(link_);
+  const auto cfg = s_.run(rcb4::ops::read_config{});
+  return json{{"ram", entries_json(t.ram.entries, *o_.layout, m_)},
+              {"rom", entries_json(t.rom.entries, *o_.layout, m_)},
+              {"same", t.same()},
+              {"problem", t.ram.problem.empty() ? json(nullptr) : json(t.ram.problem)},
+              {"rom_program", cfg.rom_program}};
+}
+
+json studio_ops::trims() {
+  json out = json::array();
+  for (const auto& t : sv::read_trims(link_, m_, {})) {
+    const auto rom = t.rom_degrees();
+    out.push_back({{"name", t.j->name},
+                   {"allocated", t.allocated},
+                   {"degrees", t.allocated ? json(std::round(t.degrees() * 100) / 100) : json(nullptr)},
+                   {"rom_degrees", rom ? json(std::round(*rom * 100) / 100) : json(nullptr)}});
+  }
+  return json{{"trims", out}};
+}
+
+json studio_ops::hand(const std::string& joint, double degrees) {
+  const auto* j = m_.find(joint);
+  if (!j) throw studio_refusal("hand: no joint is called '" + joint + "'");
+  if (!s_.is_virtual()) throw studio_refusal("hand: only the virtual board has a hand; move the real robot yourself");
+  const auto p = robot::to_position(*j, std::clamp(degrees, j->lower, j->upper));
+  if (!robot::ok(p)) throw studio_refusal("hand: " + std::get<robot::problem>(p).message);
+  const auto target = s_.by_hand(j->ics, std::get<rcb4::servo_position>(p).value());
+  if (!target) throw studio_refusal("hand: " + joint + " has no servo on the virtual board");
+  if (*target != 0x8000) throw studio_refusal("hand: " + joint + " holds its position: free it first");
+  return json{{"joint", joint}, {"degrees", std::clamp(degrees, j->lower, j->upper)}};
+}
+
+json studio_ops::rom_backup() {
+  const auto image = sv::backup_rom(link_);
+  return json{{"bytes", image.size()},
+              {"crc32", fmt::format("{:08x}", sv::crc32(image))},
+              {"base64", base64(image)},
+              {"file", fmt::format("rcb4-rom-{}.bin", sv::file_stamp())}};
+}
+
+}  // namespace cli::ui
