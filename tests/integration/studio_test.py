@@ -201,6 +201,27 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
               f"pulled back: the same three poses and times, and the name ({poses_back}, {doc.get('name')})")
         wait_until(lambda: js(driver, "return window.rcb4Studio.view && window.rcb4Studio.view.stats.frames") > 5)
         shot(driver, "rcb4-studio-editor.png")
+        # The ROM: backed up through the page, and a restore checked as the tool checks it.
+        r = driver.execute_async_script("window.rcb4Studio.request({op: 'rom_backup'}).then(arguments[0], "
+                                        "(e) => arguments[0]({error: e.message}))")
+        check(r.get("bytes") == 262144 and len(r.get("crc32", "")) == 8, f"rom_backup: 256 KiB and its CRC-32 ({r.get('error')})")
+        import base64
+        import binascii
+        image = base64.b64decode(r["base64"])
+        check(f"{binascii.crc32(image):08x}" == r["crc32"], "the CRC-32 is the image's")
+        erased = os.path.join(poses, "erased.bin")
+        with open(erased, "wb") as f:
+            f.write(b"\xff" * 262144)
+        same = os.path.join(poses, "same.bin")
+        with open(same, "wb") as f:
+            f.write(image)
+        click(driver, "css", "#rom-panel summary")
+        for path, want in ((erased, "no "), (same, "already was that image")):
+            js(driver, "document.querySelector('#message').textContent = ''; document.querySelector('#rom-file').hidden = false")
+            driver.find_element("id", "rom-file").send_keys(path)
+            said = wait_until(lambda: ("restore" in message(driver).lower() or "image" in message(driver)
+                                       or "boot" in message(driver)) and message(driver), timeout=30)
+            check(said and want in said, f"restore of {os.path.basename(path)} through the page: {said!r}")
         # A second page watching is told why its controls are off.
         second = browser()
         try:

@@ -75,7 +75,8 @@ inline const json& required(const json& o, std::string_view op, std::string_view
 /** The ops studio_messages.cpp knows, for the message naming the known ones. */
 inline constexpr std::string_view studio_ops_list =
     "motion_list, motion_pull, motion_check, buttons, trims, motion_push, motion_erase, motion_resume, play_motion, "
-    "button_set, button_clear, button_press, button_release, trim_set, hand, rom_backup";
+    "button_set, button_clear, button_press, button_release, trim_set, hand, rom_backup, rom_restore_begin, "
+    "rom_restore_piece, rom_restore_commit";
 
 /** A studio op's request (studio_messages.cpp), or nothing when @p op is none of them; throws refused. */
 std::optional<request> studio_body_of(const json& o, const std::string& op);

@@ -31,6 +31,9 @@
 //   {"op":"trim_set","joints":{"left_knee":1.5},"persist":false}
 //   {"op":"hand","joint":"left_knee","degrees":30}     turn a freed joint by hand (the virtual board only)
 //   {"op":"rom_backup"}                                the whole ROM, base64, with its CRC-32
+//   {"op":"rom_restore_begin","bytes":262144,"crc32":"1a2b3c4d"}   an image uploaded in pieces:
+//   {"op":"rom_restore_piece","offset":0,"base64":"..."}          (at most 45,000 bytes each)
+//   {"op":"rom_restore_commit","force":false}          then written as `rcb4 rom restore` writes it
 //
 // Anything else (not JSON, an unknown op or key, a wrong type, a value out of range, more than
 // max_message_bytes, nesting deeper than an object of arrays) is a parse_error with the reason.

@@ -80,6 +80,28 @@ std::optional<request> studio_body_of(const json& o, const std::string& op) {
     }
     flag_of(o, op, "persist");
     r.writes = true;
+  } else if (op == "rom_restore_begin") {
+    only_keys(o, op, {"op", "id", "bytes", "crc32"});
+    const auto& n = required(o, op, "bytes");
+    if (!n.is_number_integer() || n.get<std::int64_t>() != 262144)
+      throw refused{"rom_restore_begin: 'bytes' must be 262144: a ROM image is 256 KiB"};
+    const auto& c = required(o, op, "crc32");
+    if (!c.is_string() || c.get_ref<const std::string&>().size() != 8 ||
+        c.get_ref<const std::string&>().find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+      throw refused{"rom_restore_begin: 'crc32' must be 8 hexadecimal digits"};
+  } else if (op == "rom_restore_piece") {
+    only_keys(o, op, {"op", "id", "offset", "base64"});
+    const auto& at = required(o, op, "offset");
+    if (!at.is_number_integer() || at.get<std::int64_t>() < 0 || at.get<std::int64_t>() >= 262144)
+      throw refused{"rom_restore_piece: 'offset' must be 0..262143"};
+    const auto& b = required(o, op, "base64");
+    if (!b.is_string() || b.get_ref<const std::string&>().size() > 60000 ||
+        b.get_ref<const std::string&>().find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/=") != std::string::npos)
+      throw refused{"rom_restore_piece: 'base64' must be at most 60,000 characters of base64"};
+  } else if (op == "rom_restore_commit") {
+    only_keys(o, op, {"op", "id", "force"});
+    flag_of(o, op, "force");
   } else if (op == "hand") {
     only_keys(o, op, {"op", "id", "joint", "degrees"});
     name_of(required(o, op, "joint"), op, "joint");

@@ -25,7 +25,9 @@ namespace mo = rcb4::motion;
 
 /** The page's words for a service's refusal: what, and what to do. */
 std::string words(const sv::refused& e) {
-  return e.hint.empty() ? std::string(e.what()) : std::string(e.what()) + " (" + e.hint + ")";
+  auto hint = e.hint;
+  if (const auto at = hint.find("--force"); at != std::string::npos) hint.replace(at, 7, "ticking force");  // the page's box
+  return hint.empty() ? std::string(e.what()) : std::string(e.what()) + " (" + hint + ")";
 }
 
 std::string base64(std::span<const std::uint8_t> b) {
@@ -38,6 +40,29 @@ std::string base64(std::span<const std::uint8_t> b) {
     out += digits[(v >> 12) & 63];
     out += i + 1 < b.size() ? digits[(v >> 6) & 63] : '=';
     out += i + 2 < b.size() ? digits[v & 63] : '=';
+  }
+  return out;
+}
+
+std::vector<std::uint8_t> unbase64(const std::string& text) {
+  std::vector<std::uint8_t> out;
+  unsigned acc = 0;
+  int bits = 0;
+  for (const char c : text) {
+    int v = -1;
+    if (c >= 'A' && c <= 'Z') v = c - 'A';
+    else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
+    else if (c >= '0' && c <= '9') v = c - '0' + 52;
+    else if (c == '+') v = 62;
+    else if (c == '/') v = 63;
+    else if (c == '=') break;
+    else throw studio_refusal("rom_restore_piece: not base64");
+    acc = (acc << 6) | static_cast<unsigned>(v);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<std::uint8_t>((acc >> bits) & 0xFF));
+    }
   }
   return out;
 }
@@ -132,6 +157,15 @@ json studio_ops::act(const studio_action& a, client_id from) {
     }
     if (op == "hand") return hand(args.at("joint").get<std::string>(), args.at("degrees").get<double>());
     if (op == "rom_backup") return rom_backup();
+    if (op == "rom_restore_begin") {
+      upload_.assign(rcb4::rom_size, 0xFF);
+      uploaded_.assign(rcb4::rom_size, false);
+      upload_crc_ = static_cast<std::uint32_t>(std::stoul(args.at("crc32").get<std::string>(), nullptr, 16));
+      return json{{"bytes", upload_.size()}};
+    }
+    if (op == "rom_restore_piece")
+      return rom_restore_piece(args.at("offset").get<std::size_t>(), args.at("base64").get<std::string>());
+    if (op == "rom_restore_commit") return rom_restore_commit(args.value("force", false));
     throw studio_refusal("unknown studio op " + op);
   } catch (const sv::refused& e) {
     throw studio_refusal(words(e));
@@ -317,6 +351,49 @@ json studio_ops::rom_backup() {
               {"crc32", fmt::format("{:08x}", sv::crc32(image))},
               {"base64", base64(image)},
               {"file", fmt::format("rcb4-rom-{}.bin", sv::file_stamp())}};
+}
+
+json studio_ops::rom_restore_piece(std::size_t offset, const std::string& base64) {
+  if (upload_.empty()) throw studio_refusal("rom_restore_piece: no upload begun (rom_restore_begin first)");
+  const auto bytes = unbase64(base64);
+  if (offset + bytes.size() > upload_.size())
+    throw studio_refusal(fmt::format("rom_restore_piece: {} bytes at {} go past the ROM's end", bytes.size(), offset));
+  std::copy(bytes.begin(), bytes.end(), upload_.begin() + static_cast<std::ptrdiff_t>(offset));
+  std::fill(uploaded_.begin() + static_cast<std::ptrdiff_t>(offset),
+            uploaded_.begin() + static_cast<std::ptrdiff_t>(offset + bytes.size()), true);
+  return json{{"received", std::count(uploaded_.begin(), uploaded_.end(), true)}};
+}
+
+json studio_ops::rom_restore_commit(bool force) {
+  // The checks `rcb4 rom restore` makes: the whole image, its CRC-32, then the service's own.
+  if (upload_.empty()) throw studio_refusal("rom_restore_commit: no upload begun");
+  const auto missing = std::count(uploaded_.begin(), uploaded_.end(), false);
+  auto image = std::move(upload_);
+  upload_.clear();
+  uploaded_.clear();
+  if (missing)
+    throw studio_refusal(fmt::format("the image arrived without {} of its bytes: nothing was written", missing));
+  if (const auto crc = sv::crc32(image); crc != upload_crc_)
+    throw studio_refusal(fmt::format("the image's CRC-32 is {:08x}, not the {:08x} the page computed: it was damaged on "
+                                     "the way; nothing was written",
+                                     crc, upload_crc_));
+  const auto version = s_.run(rcb4::ops::read_version{});
+  const auto r = sv::restore_rom(
+      link_, image,
+      [&](std::span<const std::uint8_t> now) {
+        const auto dir = o_.poses / "backups";
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        const auto path = (dir / fmt::format("rom-before-restore-{}.bin", sv::file_stamp())).string();
+        sv::save_rom_image(path, now, version);
+        return path;
+      },
+      force);
+  return json{{"pieces_written", r.pieces},
+              {"unchanged", r.unchanged},
+              {"before", r.before},
+              {"buttons_loaded", r.buttons_loaded},
+              {"program_stopped", r.program_stopped}};
 }
 
 }  // namespace cli::ui

@@ -16,6 +16,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace cli::ui {
 
@@ -54,6 +55,8 @@ class studio_ops {
   json trims();
   json hand(const std::string& joint, double degrees);
   json rom_backup();
+  json rom_restore_piece(std::size_t offset, const std::string& base64);
+  json rom_restore_commit(bool force);
 
   session& s_;
   const rcb4::robot::model& m_;
@@ -64,6 +67,9 @@ class studio_ops {
   std::optional<clock::time_point> play_next_;
   client_id play_from_ = 0;
   std::string play_name_;
+  std::vector<std::uint8_t> upload_;        ///< a ROM image being uploaded (rom_restore_begin … commit)
+  std::vector<bool> uploaded_;              ///< which of its bytes came
+  std::uint32_t upload_crc_ = 0;            ///< the CRC-32 the page says it has
 };
 
 }  // namespace cli::ui

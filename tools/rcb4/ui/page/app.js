@@ -390,7 +390,7 @@ async function buildStudio(h) {
   const view = await createView($('#view3d'), h, { onSelect: selectJoint, onHand });
   ctx.view = view;
   ui.studio.view = view;
-  window.rcb4Studio = { view, editor, tables, hello: h };  // for the tests and the benchmark (frames drawn, state)
+  window.rcb4Studio = { view, editor, tables, hello: h, request };  // for the tests and the benchmark (frames drawn, state)
   if (view) { view.setMeasured(ui.measured); editor.render(); }
 }
 

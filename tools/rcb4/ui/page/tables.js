@@ -11,6 +11,16 @@ const PAD = [['s1', 0, 0], ['s2', 1, 0], ['s3', 5, 0], ['s4', 6, 0],
   ['down', 1, 3], ['cross', 5, 3]];
 const SYMBOL = { up: '▲', down: '▼', left: '◀', right: '▶', triangle: '△', circle: '○', cross: '✕', square: '□' };
 
+/** The CRC-32 (IEEE 802.3, as zlib and `rcb4 rom backup` compute it) of @p bytes. */
+function crc32(bytes) {
+  let c = 0xFFFFFFFF;
+  for (const b of bytes) {
+    c ^= b;
+    for (let k = 0; k < 8; k++) c = (c >>> 1) ^ (0xEDB88320 & -(c & 1));
+  }
+  return (c ^ 0xFFFFFFFF) >>> 0;
+}
+
 export function createTables(root, ctx) {
   const tbody = el('tbody', { id: 'slots' });
   const chosen = new Set();
@@ -26,6 +36,8 @@ export function createTables(root, ctx) {
   const bslot = el('input', { id: 'button-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot the buttons play' });
   const entries = el('ul', { id: 'button-entries', class: 'list' });
   const trims = el('div', { id: 'trims', class: 'trims' });
+  const romFile = el('input', { id: 'rom-file', type: 'file', accept: '.bin', hidden: true });
+  const romForce = el('input', { id: 'rom-force', type: 'checkbox', class: 'needs-control' });
   const persist = el('button', { id: 'trims-persist', type: 'button', class: 'needs-control', title: 'write the trims shown into ROM, which the board loads at power-on' }, 'Keep in ROM');
   const bt = (id, text, title, fn, cls = 'needs-control') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
   root.replaceChildren(
@@ -49,7 +61,8 @@ export function createTables(root, ctx) {
       trims, el('div', { class: 'row' }, bt('trims-refresh', 'Read', 'read the trims again', () => readTrims(), ''), persist)),
     el('details', { id: 'rom-panel' }, el('summary', {}, 'ROM'),
       el('div', { class: 'row' }, bt('rom-backup', 'Back up the ROM', 'download the whole ROM (256 KiB) with its CRC-32', backup)),
-      el('div', { class: 'small muted', text: 'restore a backup with: rcb4 rom restore FILE (checked, the replaced ROM saved first)' })));
+      el('div', { class: 'row' }, romFile, bt('rom-restore', 'Restore…', 'write a backup back (checked as rcb4 rom restore checks it; the ROM it replaces saved first)', () => romFile.click())),
+      el('label', { class: 'small' }, romForce, ' write an image that is no RCB-4 program (force)')));
 
   function paintPad() {
     for (const k of pad.children) k.setAttribute('aria-pressed', String(chosen.has(k.dataset.button)));
@@ -131,6 +144,26 @@ export function createTables(root, ctx) {
     setTimeout(() => URL.revokeObjectURL(a.href), 5000);
     ctx.say(`ROM backed up: ${r.bytes} bytes, CRC-32 ${r.crc32} (${r.file})`);
   }
+
+  // A restore: the image sent in pieces with its CRC-32; the server checks both, then the robot
+  // service checks the image and writes where it differs.
+  romFile.addEventListener('change', async () => {
+    const f = romFile.files[0];
+    romFile.value = '';
+    if (!f) return;
+    const bytes = new Uint8Array(await f.arrayBuffer());
+    if (bytes.length !== 262144) return ctx.say(`${f.name}: ${bytes.length} bytes; a ROM image is 262,144 (nothing written)`, 'error');
+    if (!(await ask({ op: 'rom_restore_begin', bytes: bytes.length, crc32: crc32(bytes).toString(16).padStart(8, '0') }))) return;
+    for (let at = 0; at < bytes.length; at += 45000) {
+      const piece = bytes.subarray(at, Math.min(at + 45000, bytes.length));
+      let text = '';
+      for (let i = 0; i < piece.length; i += 8192) text += String.fromCharCode(...piece.subarray(i, i + 8192));
+      if (!(await ask({ op: 'rom_restore_piece', offset: at, base64: btoa(text) }))) return;
+    }
+    const r = await ask({ op: 'rom_restore_commit', force: romForce.checked });
+    if (r) ctx.say(r.unchanged ? 'the ROM already was that image: nothing written'
+      : `restored: ${r.pieces_written} pieces written; the ROM it replaced is in ${r.before}`);
+  });
 
   paintPad();
   root.querySelector('#buttons-panel').addEventListener('toggle', (e) => { if (e.target.open) readButtons(); });
