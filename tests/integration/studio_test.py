@@ -172,11 +172,31 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
                          and not js(driver, "return window.rcb4State.motion.running"), timeout=10),
               f"and it ends at its last pose ({measured(driver, 'left_knee')})")
         shot(driver, "rcb4-studio-buttons.png")
+        # Trims: set live, then kept in ROM.
+        click(driver, "css", "#trims-panel summary")
+        wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, '#trims input[data-joint="left_knee"]'), timeout=10)
+        js(driver, """const n = document.querySelector('#trims input[data-joint="left_knee"]');
+                      n.value = 1.5; n.dispatchEvent(new Event('change'));""")
+        check(wait_until(lambda: "left_knee trim 1.5" in message(driver), timeout=10), f"a trim set live ({message(driver)!r})")
+        click(driver, "id", "trims-persist")
+        check(wait_until(lambda: "kept in ROM" in message(driver), timeout=10), f"and kept in ROM ({message(driver)!r})")
+        # A motion saved as the YAML file the tool reads.
+        yaml_text = driver.execute_async_script(
+            "window.rcb4Studio.request({op: 'motion_check', text: JSON.stringify(window.rcb4Studio.editor.doc)})"
+            ".then((r) => arguments[0](r.yaml), (e) => arguments[0]('ERROR ' + e.message))")
+        with open(os.path.join(poses, "saved.yaml"), "w") as f:
+            f.write(yaml_text)
     finally:
         driver.quit()
         ui.stop()
 
     # On the board, through the tool.
+    rc, out, err = run("--json", "--device", dev, "trim", "get", "left_knee")
+    t = json.loads(out)[0] if rc == 0 else {}
+    check(abs(t.get("degrees", 0) - 1.5) < 0.05 and abs((t.get("rom_degrees") or 0) - 1.5) < 0.05,
+          f"rcb4 trim get: left_knee 1.5 in RAM and ROM ({t})")
+    rc, out, err = run("--device", dev, "motion", "push", os.path.join(poses, "saved.yaml"), "10", "--dry-run")
+    check(rc == 0 and "would write 150 bytes" in out, f"the saved YAML is a motion file the tool pushes ({rc}: {out[:80]!r} {err.strip()!r})")
     rc, out, err = run("--device", dev, "motion", "show", "10")
     consts = out.count("CONST")
     check(rc == 0 and consts == 3 and "RETURN" in out, f"motion show 10: three CONST frames and a RETURN ({consts}; {err.strip()!r})")

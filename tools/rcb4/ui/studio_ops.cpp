@@ -35,7 +35,8 @@ std::string base64(std::span<const std::uint8_t> b) {
   std::string out;
   out.reserve((b.size() + 2) / 3 * 4);
   for (std::size_t i = 0; i < b.size(); i += 3) {
-    const unsigned v = (b[i] << 16u) | (i + 1 < b.size() ? b[i + 1] << 8u : 0u) | (i + 2 < b.size() ? b[i + 2] : 0u);
+    const auto byte = [&](std::size_t k) { return k < b.size() ? unsigned{b[k]} : 0u; };
+    const unsigned v = (byte(i) << 16u) | (byte(i + 1) << 8u) | byte(i + 2);
     out += digits[(v >> 18) & 63];
     out += digits[(v >> 12) & 63];
     out += i + 1 < b.size() ? digits[(v >> 6) & 63] : '=';
