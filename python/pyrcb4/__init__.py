@@ -48,8 +48,9 @@ def _one_line(name, method):
                     takes = line.strip()[3:].split(") -> ")[0] + ")"
                     takes = takes.replace("self: pyrcb4._core.Board, ", "").replace("self: pyrcb4._core.Board", "")
                     takes = takes.replace("*args", "*names")
-            given = ", ".join([repr(a) for a in args[1:]] + [f"{k}={v!r}" for k, v in kwargs.items()])
-            raise ArgumentError(f"{name}{takes or '(...)'}: called with ({given})") from None
+            given = repr(tuple(args[1:])) if not kwargs else \
+                "(" + ", ".join([repr(a) for a in args[1:]] + [f"{k}={v!r}" for k, v in kwargs.items()]) + ")"
+            raise ArgumentError(f"{name}{takes or '(...)'}: called with {given}") from None
     return call
 
 

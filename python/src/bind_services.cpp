@@ -36,6 +36,17 @@ std::uint16_t button_word(const py::object& buttons) {
   return std::get<std::uint16_t>(b);
 }
 
+/** A motion file to write (.yaml or .yml), checked before the board is asked; empty for None. */
+std::string motion_file_path(const py::object& path, bool force) {
+  if (path.is_none()) return {};
+  auto p = path_of(path);
+  const auto ext = std::filesystem::path(p).extension();
+  if (ext != ".yaml" && ext != ".yml") throw board_error(fault::usage, "path: " + p + " does not end in .yaml or .yml");
+  if (std::filesystem::exists(p) && !force)
+    throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
+  return p;
+}
+
 /** A motion number, checked before anything is read. */
 unsigned motion_number(long long n) {
   if (n < 1 || n > 120) throw board_error(fault::usage, "motion " + std::to_string(n) + " is outside 1..120");
@@ -138,15 +149,7 @@ void bind_services(py::class_<board>& cls) {
           "pull_motion",
           [](board& b, long long n, const py::object& path, bool force) {
             const auto k = motion_number(n);
-            std::string p;
-            if (!path.is_none()) {
-              p = path_of(path);
-              const auto ext = std::filesystem::path(p).extension();
-              if (ext != ".yaml" && ext != ".yml")
-                throw board_error(fault::usage, "path: " + p + " does not end in .yaml or .yml");
-              if (std::filesystem::exists(p) && !force)
-                throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
-            }
+            const auto p = motion_file_path(path, force);
             const auto r = unlocked([&] { return b.pull_motion(k); });
             if (!p.empty()) {
               try {
@@ -220,15 +223,7 @@ void bind_services(py::class_<board>& cls) {
           "record",
           [](board& b, const py::object& path, const py::object& joints, double every, const py::object& seconds,
              bool free, double threshold, bool force) {
-            std::string p;
-            if (!path.is_none()) {
-              p = path_of(path);
-              const auto ext = std::filesystem::path(p).extension();
-              if (ext != ".yaml" && ext != ".yml")
-                throw board_error(fault::usage, "path: " + p + " does not end in .yaml or .yml");
-              if (std::filesystem::exists(p) && !force)
-                throw board_error(fault::usage, "path: " + p + " exists (force=True replaces it)");
-            }
+            const auto p = motion_file_path(path, force);
             std::vector<std::string> words;
             if (!joints.is_none()) {
               if (py::isinstance<py::str>(joints)) throw board_error(fault::usage, "joints: a list of names");
@@ -245,7 +240,8 @@ void bind_services(py::class_<board>& cls) {
               });
             });
             PyErr_Clear();  // Ctrl-C ends a recording: what was recorded is the result
-            if (!p.empty()) {
+            const bool partial = r.document.steps.size() > 1;  // at least one pose before end
+            if (!p.empty() && partial) {
               try {
                 rcb4::robot::save_motion(p, r.document,
                                          fmt::format("recorded by pyrcb4: {} samples over {:.1f} s", r.samples,
@@ -258,7 +254,12 @@ void bind_services(py::class_<board>& cls) {
             d["samples"] = r.samples;
             d["clamped"] = r.clamped;
             d["held"] = r.held;
-            d["file"] = p.empty() ? py::object(py::none()) : py::object(py::str(p));
+            d["file"] = p.empty() || !partial ? py::object(py::none()) : py::object(py::str(p));
+            if (r.lost)
+              raise(r.lost, "record" + (p.empty() || !partial
+                                            ? std::string(": nothing recorded")
+                                            : ": the " + std::to_string(r.document.steps.size() - 1) +
+                                                  " poses recorded before the board stopped answering are in " + p));
             return d;
           },
           "path"_a = py::none(), "joints"_a = py::none(), "every"_a = 0.1, "seconds"_a = py::none(), "free"_a = false,

@@ -147,7 +147,8 @@ void board::fail(const std::error_code& ec, const std::string& what) {
   // (A cooked line even reads as closed: its end-of-file character, ^D, may be a byte of a reply.)
   const bool line_fault = ec == t::transport_errc::timeout || ec == t::transport_errc::no_board ||
                           ec == t::transport_errc::truncated || ec == t::transport_errc::closed ||
-                          ec == t::transport_errc::echo || ec.category() == rcb4::codec_category();
+                          ec == t::transport_errc::settings_not_kept || ec == t::transport_errc::echo ||
+                          ec.category() == rcb4::codec_category();
   if (line_fault && line_fd_ >= 0) {
     t::detail::kernel_termios2 now{};
     if (::ioctl(line_fd_, t::detail::tcgets2, &now) == 0) {
@@ -295,17 +296,21 @@ std::vector<const rcb4::robot::joint*> board::joints_named(const std::vector<std
   return js;
 }
 
-std::vector<std::string> board::power(bool free, const std::vector<std::string>& words) {
+std::pair<rcb4::servo_mask, std::vector<std::string>> board::servos_of(const std::vector<std::string>& words) {
   const auto js = joints_named(words);
   const auto& map = joints_located();
-  rcb4::servo_mask mask;
-  std::vector<std::string> done;
+  std::pair<rcb4::servo_mask, std::vector<std::string>> out;
   for (const auto* j : js)
     if (map.block_of(*j)) {
-      mask.insert(j->ics);
-      done.push_back(j->name);
+      out.first.insert(j->ics);
+      out.second.push_back(j->name);
     }
-  if (mask.empty()) throw board_error(fault::refused, "none of these joints has a servo on the board");
+  if (out.first.empty()) throw board_error(fault::refused, "none of these joints has a servo on the board");
+  return out;
+}
+
+std::vector<std::string> board::power(bool free, const std::vector<std::string>& words) {
+  const auto [mask, done] = servos_of(words);
   run(rcb4::ops::set_servo_power(free ? rcb4::ops::power_state::free : rcb4::ops::power_state::hold, mask),
       free ? "free" : "hold");
   return done;
@@ -343,16 +348,7 @@ std::vector<std::string> board::set_param(bool speed, long long value, const std
   if (value < 1 || value > 127)
     throw board_error(fault::usage, std::string(what) + ": 1..127 (the ICS parameter), not " + std::to_string(value));
   const auto v = rcb4::servo_param::make(static_cast<int>(value));
-  const auto js = joints_named(words);
-  const auto& map = joints_located();
-  rcb4::servo_mask mask;
-  std::vector<std::string> done;
-  for (const auto* j : js)
-    if (map.block_of(*j)) {
-      mask.insert(j->ics);
-      done.push_back(j->name);
-    }
-  if (mask.empty()) throw board_error(fault::refused, "none of these joints has a servo on the board");
+  const auto [mask, done] = servos_of(words);
   run(rcb4::ops::set_servo_param(speed ? rcb4::param_kind::speed : rcb4::param_kind::stretch, *v, mask), what);
   return done;
 }

@@ -203,6 +203,8 @@ class board {
   void refuse_if_motion_runs(const char* what);
   /** A failure of @p what: when another program changed the serial line's settings, set again and said so. */
   [[noreturn]] void fail(const std::error_code& ec, const std::string& what);
+  /** The servos of the joints @p words name that the board has blocks for, and their names; refused when none. */
+  std::pair<rcb4::servo_mask, std::vector<std::string>> servos_of(const std::vector<std::string>& words);
   /** The joints @p words name (joints, groups, "all"; none: all), each once. */
   std::vector<const rcb4::robot::joint*> joints_named(const std::vector<std::string>& words) const;
   const rcb4::rom_layout& layout();

@@ -235,7 +235,13 @@ sv::record_report board::record(const std::vector<std::string>& words, double ev
     const auto until =
         start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
     for (auto next = start;;) {
-      rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start));
+      try {
+        rec.sample(std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start));
+      } catch (const std::system_error& e) {  // the board went away: what was recorded is kept and said
+        auto r = rec.finish(true);
+        r.lost = e.code();
+        return r;
+      }
       next += every;
       if (seconds > 0 && next > until) break;
       if (!sleep_until(next, stopped)) break;

@@ -74,6 +74,9 @@ inline double number_of(const py::handle& v, const std::string& what) {
 
 /** A path given as str or os.PathLike, as os.fspath gives it. */
 inline std::string path_of(const py::object& path) {
+  if (!py::isinstance<py::str>(path) && !py::hasattr(path, "__fspath__"))
+    throw board_error(fault::usage,
+                      "a path (str or os.PathLike) was expected, not " + py::repr(path).cast<std::string>());
   return py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>();
 }
 

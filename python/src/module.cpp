@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <map>
 
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/motion/player.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
 #include <pybind11/numpy.h>
@@ -350,19 +352,35 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "motions",
           [](board& b) {
             const std::vector<rcb4::ops::motion_slot> v = unlocked([&] { return b.motions(); });
+            const auto period = unlocked([&] { return b.period(); });
             const auto names = load_names(b);
             py::list out;
             for (const auto& s : v) {
               const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names);
+              // Its seconds as the board plays it (loops counted, no button held), where the steps express it.
+              py::object seconds = py::none();
+              if (s.ends) {
+                const rcb4::motion::slot where{rcb4::rom_address::make(s.address).value(), 2048};
+                if (auto p = rcb4::motion::lift(rcb4::motion::disassemble(s.code, where)); rcb4::motion::ok(p)) {
+                  const auto t = rcb4::motion::play_time(std::get<rcb4::motion::program>(p));
+                  if (!t.endless && t.error.empty() && t.calls == 0)
+                    seconds = py::float_(static_cast<double>(t.frames) * rcb4::milliseconds(period) / 1000.0);
+                  else if (t.endless)
+                    seconds = py::float_(std::numeric_limits<double>::infinity());
+                }
+              }
               out.append(
                   py::dict("slot"_a = s.number,
                            "name"_a = name.empty() ? py::object(py::none()) : py::object(py::str(std::string(name))),
-                           "address"_a = s.address, "size"_a = s.size, "frames"_a = s.frames));
+                           "address"_a = s.address, "size"_a = s.size, "frames"_a = s.frames, "seconds"_a = seconds,
+                           "ends"_a = s.ends, "readable"_a = s.readable));
             }
             return out;
           },
           "The used motion slots in ROM: slot, name (the slot's name, kept when a motion file with a name is pushed; "
-          "else the profile's), address, size, frames (the protocol's commands walked to the first RETURN).")
+          "else the profile's), address, size, frames (the protocol's commands walked to the first RETURN), seconds "
+          "(as the board plays it, loops counted; inf: for ever; None: it calls other motions or is not steps), "
+          "ends, readable.")
       .def(
           "sensors",
           [](board& b) {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <numbers>
 
@@ -137,15 +138,26 @@ std::string xml(std::string_view text) {
 
 }  // namespace
 
+/** The robot's name as an XML name and a comment's text allow it. */
+std::string robot_name_of(const model& m) {
+  std::string out;
+  for (const char c : m.name()) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
 std::string to_urdf(const model& m, const urdf_options& o) {
   const auto* k = m.body();
   if (!k) throw profile_error(m.name(), "the profile has no kinematics: section, so no body to write as URDF");
   std::string out = "<?xml version=\"1.0\"?>\n";
-  out += fmt::format("<!-- {} as rcb4 describes it: simple shapes, not the robot's own meshes. -->\n", xml(m.name()));
-  if (!k->source.empty()) out += fmt::format("<!-- Figures: {} -->\n", xml(k->source));
-  std::string robot_name;
-  for (const char c : m.name()) robot_name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  out += fmt::format("<robot name=\"{}\">\n", xml(robot_name));
+  out += fmt::format("<!-- the robot {} as rcb4's profile describes it: simple shapes, not its meshes. -->\n",
+                     robot_name_of(m));
+  if (!k->source.empty()) {
+    // A comment holds any text but "--" (XML 1.0 §2.5); entities are not read there.
+    auto source = k->source;
+    for (auto at = source.find("--"); at != std::string::npos; at = source.find("--", at)) source.replace(at, 2, "- -");
+    out += fmt::format("<!-- Figures: {} -->\n", source);
+  }
+  out += fmt::format("<robot name=\"{}\">\n", robot_name_of(m));
   out += "  <material name=\"rcb4_body\"><color rgba=\"0.8 0.8 0.82 1\"/></material>\n";
   for (const auto& l : k->links) {
     out += fmt::format("  <link name=\"{}{}\">\n", xml(o.prefix), xml(l.name));

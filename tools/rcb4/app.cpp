@@ -375,8 +375,18 @@ failure explain(const std::error_code& ec, std::string_view what) {
       message.replace(at, ec.message().size(), "not a serial port");
     return {exit_io, message, "give the serial port the board is on (`rcb4 list`), or tcp:HOST:PORT for a bridge"};
   }
-  if (ec == std::errc::no_such_file_or_directory)
-    return {exit_io, std::string(what), "no such device: `rcb4 list` shows the serial ports"};
+  if (ec == std::errc::no_such_file_or_directory) {
+    // "127.0.0.1:4000" (what `rcb4 serve --tcp` prints) is a bridge's address, not a path.
+    const auto w = std::string(what);
+    const auto colon = w.find(':');
+    const auto host = w.substr(0, colon);
+    const bool address = colon != std::string::npos && colon > 0 && host.find('/') == std::string::npos &&
+                         w.find_first_not_of("0123456789", colon + 1) > colon + 1 &&
+                         std::isdigit(static_cast<unsigned char>(w[colon + 1]));
+    return {exit_io, w,
+            address ? fmt::format("no such device; for a TCP bridge write tcp:{}", w.substr(0, w.find(": ")))
+                    : "no such device: `rcb4 list` shows the serial ports"};
+  }
   if (t::is_link_lost(ec))
     return {exit_io, std::string(what),
             "the device went away (unplugged?); over TCP at the first exchange: the server has another client "

@@ -381,12 +381,14 @@ void add_motion_commands(CLI::App& app, context& ctx) {
         if (auto p = rcb4::motion::lift(rcb4::motion::disassemble(v.code, where)); rcb4::motion::ok(p))
           plays = rcb4::motion::play_time(std::get<rcb4::motion::program>(p));
       }
+      // A motion that calls others plays for as long as they do too: not counted here ("calls").
       const auto seconds = [&]() -> std::optional<double> {
-        if (!plays || plays->endless || !plays->error.empty()) return std::nullopt;
+        if (!plays || plays->endless || !plays->error.empty() || plays->calls) return std::nullopt;
         return std::round(static_cast<double>(plays->frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
       }();
       const std::string seconds_text = !plays           ? "-"
                                        : plays->endless ? "for ever"
+                                       : plays->calls   ? "calls"
                                        : seconds        ? fmt::format("{:.2f}", *seconds)
                                                         : "-";
       const std::string note = !v.readable ? "not a frame: another --layout?" : v.ends ? "" : "no RETURN found";

@@ -248,8 +248,7 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
     if (g.json)
       emit(json{{"played", file}, {"interrupted", true}, {"poses", play.poses()}, {"seconds", seconds()}});
     else
-      fmt::print(stderr,
-                 "interrupted at step {} after {} ({:.1f} s): the servos stay where the last pose took them{}\n",
+      fmt::print(stderr, "interrupted at step {} after {} ({:.1f} s): the servos it moved hold where they are{}\n",
                  play.step(), plural(play.poses(), "pose"), seconds(),
                  play.calls() ? " (a ROM motion it called was stopped: rcb4 motion play N starts afresh)" : "");
     return exit_interrupted;

@@ -96,6 +96,8 @@ std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::millise
       return std::nullopt;
     }
     if (const auto* snd = std::get_if<mo::send>(&a)) {
+      if (const auto* c = std::get_if<rcb4::const_servo>(&snd->cmd))
+        for (const auto ics : c->targets().mask()) moved_.insert(ics);
       run(l_, rcb4::ops::detail::ack_sequence({snd->cmd}));
       ready_ = std::max(ready_, now) + snd->frames * frame;
       if (ready_ > now) return ready_;
@@ -119,9 +121,12 @@ std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::millise
 }
 
 void host_play::stop() {
-  if (!callee_since_) return;
-  callee_since_.reset();
-  run(l_, rcb4::ops::stop_motion{});
+  if (callee_since_) {
+    callee_since_.reset();
+    run(l_, rcb4::ops::stop_motion{});
+  }
+  // A pose under way would go on to its end: every servo the play moved holds where it is now.
+  if (!moved_.empty()) run(l_, rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, moved_));
 }
 
 }  // namespace rcb4::robot::services

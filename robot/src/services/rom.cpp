@@ -46,14 +46,16 @@ std::uint32_t crc32(std::span<const std::uint8_t> bytes) noexcept {
   return ~c;
 }
 
+std::string crc32_line(const std::string& name, std::span<const std::uint8_t> image, const std::string& version) {
+  return fmt::format("{:08x}  {}  {} bytes  {}  {}\n", crc32(image), name, image.size(), file_stamp(), version);
+}
+
 void save_rom_image(const std::string& path, std::span<const std::uint8_t> image, const std::string& version) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
   out.flush();
-  const auto stamp = file_stamp();
   std::ofstream sum(path + ".crc32", std::ios::trunc);
-  sum << fmt::format("{:08x}  {}  {} bytes  {}  {}\n", crc32(image), std::filesystem::path(path).filename().string(),
-                     image.size(), stamp, version);
+  sum << crc32_line(std::filesystem::path(path).filename().string(), image, version);
   sum.flush();
   if (!out || !sum)
     throw refused(refusal_kind::usage, fmt::format("cannot write {} or its .crc32: {}", path, std::strerror(errno)),

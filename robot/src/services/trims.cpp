@@ -32,8 +32,11 @@ std::vector<trim_entry> read_trims(link& l, const model& robot, const std::vecto
       const auto at = static_cast<std::uint16_t>(*block + 2u);
       e.ram = word_at(run(l, rcb4::ops::read_memory(memory::ram, at, 2)), 0);
       // The servo image covers the user area only (protocol.md §8): a block elsewhere has no ROM copy.
-      if (at >= rcb4::ram::user_area.value())
-        e.rom = word_at(run(l, rcb4::ops::read_memory(memory::rom, hth4_rom::servo_image_of(at).value(), 2)), 0);
+      if (at >= rcb4::ram::user_area.value()) {
+        // Erased ROM (0xFFFF) holds no trim: power-on loads 0 for it.
+        const auto w = word_at(run(l, rcb4::ops::read_memory(memory::rom, hth4_rom::servo_image_of(at).value(), 2)), 0);
+        e.rom = w == -1 ? std::int16_t{0} : w;
+      }
     }
     out.push_back(e);
   }
@@ -82,7 +85,8 @@ trims_report set_trims(link& l, const model& robot, const std::vector<std::pair<
   for (const auto& t : trims) js.push_back(t.j);
   for (const auto& e : read_trims(l, robot, js)) {
     const auto& t = *std::find_if(trims.begin(), trims.end(), [&](const joint_trim& x) { return x.j == e.j; });
-    if (e.ram != t.counts || (persistent && e.rom && *e.rom != t.counts))
+    // (A trim of -1 count kept in ROM is 0xFFFF, erased ROM: it reads back, and loads, as 0.)
+    if (e.ram != t.counts || (persistent && e.rom && *e.rom != t.counts && t.counts != -1))
       throw refused(refusal_kind::board,
                     fmt::format("{}: trim {:+d} written, but the board reads back {:+d} (RAM){}", e.j->name, t.counts,
                                 e.ram, e.rom ? fmt::format(", {:+d} (ROM)", *e.rom) : std::string()));

@@ -272,6 +272,10 @@ class loop {
         if (a.from) h_.tell(a.from, reply_text(a.id, op, extra.is_null() ? std::string() : text_of(extra)));
     } catch (const refusal& r) {
       if (a.from) h_.tell(a.from, error_text(a.id, op, r.what));
+    } catch (
+        const std::exception& e) {  // a failure nothing above turned into words: the page hears it, the loop goes on
+      answering_ = false;
+      if (a.from) h_.tell(a.from, error_text(a.id, op, plain_message(e.what())));
     }
   }
 
@@ -375,9 +379,12 @@ class loop {
     // The state is read now, not taken from the last poll: a motion started since must stop too.
     // Stopping it comes first (it would drive the joints again), then the hold.
     if (a.motion) {
+      // Only a motion is stopped: with none (the program in its main loop) the program stays on, so
+      // the remote's buttons still play their motions.
       bool running = true;
       try {
-        running = must(ops::read_motion_state(*o_.layout), "read the motion state").running;
+        const auto st = must(ops::read_motion_state(*o_.layout), "read the motion state");
+        running = st.running && st.motion;
       } catch (const refusal&) {
         // Unknown: stop it anyway.
       }

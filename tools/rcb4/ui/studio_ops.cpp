@@ -26,7 +26,8 @@ namespace mo = rcb4::motion;
 /** The page's words for a service's refusal: what, and what to do. */
 std::string words(const sv::refused& e) {
   auto hint = e.hint;
-  if (const auto at = hint.find("--force"); at != std::string::npos) hint.replace(at, 7, "ticking force");  // the page's box
+  if (const auto at = hint.find("--force"); at != std::string::npos)
+    hint.replace(at, 7, "ticking force");  // the page's box
   return hint.empty() ? std::string(e.what()) : std::string(e.what()) + " (" + hint + ")";
 }
 
@@ -51,13 +52,20 @@ std::vector<std::uint8_t> unbase64(const std::string& text) {
   int bits = 0;
   for (const char c : text) {
     int v = -1;
-    if (c >= 'A' && c <= 'Z') v = c - 'A';
-    else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
-    else if (c >= '0' && c <= '9') v = c - '0' + 52;
-    else if (c == '+') v = 62;
-    else if (c == '/') v = 63;
-    else if (c == '=') break;
-    else throw studio_refusal("rom_restore_piece: not base64");
+    if (c >= 'A' && c <= 'Z')
+      v = c - 'A';
+    else if (c >= 'a' && c <= 'z')
+      v = c - 'a' + 26;
+    else if (c >= '0' && c <= '9')
+      v = c - '0' + 52;
+    else if (c == '+')
+      v = 62;
+    else if (c == '/')
+      v = 63;
+    else if (c == '=')
+      break;
+    else
+      throw studio_refusal("rom_restore_piece: not base64");
     acc = (acc << 6) | static_cast<unsigned>(v);
     bits += 6;
     if (bits >= 8) {
@@ -176,6 +184,10 @@ json studio_ops::act(const studio_action& a, client_id from) {
     const auto f = explain(e.code(), a.op);
     throw studio_refusal(
         fmt::format("{}: {}{}", a.op, plain_message(e.what()), f.hint.empty() ? "" : " (" + f.hint + ")"));
+  } catch (const boost::system::system_error& e) {
+    const auto f = explain(std::error_code(e.code()), a.op);
+    throw studio_refusal(
+        fmt::format("{}: {}{}", a.op, plain_message(e.what()), f.hint.empty() ? "" : " (" + f.hint + ")"));
   } catch (const json::exception& e) {  // the fields were checked by the parser: a slip of ours
     throw studio_refusal(a.op + ": " + e.what());
   }
@@ -183,8 +195,8 @@ json studio_ops::act(const studio_action& a, client_id from) {
 
 json studio_ops::list() {
   const auto& layout = *o_.layout;
-  const auto used = s_.run(rcb4::ops::list_motions(layout));
-  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  const auto used = sv::run(link_, rcb4::ops::list_motions(layout));
+  const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
   const auto names = sv::load_slot_names(m_.name());
   json slots = json::array();
   for (unsigned n = 1; n <= layout.motion_count; ++n) {
@@ -201,7 +213,8 @@ json studio_ops::list() {
         if (auto p = mo::lift(mo::disassemble(it->code, where)); mo::ok(p)) {
           const auto t = mo::play_time(std::get<mo::program>(p));
           e["endless"] = t.endless;
-          if (!t.endless && t.error.empty())
+          e["calls"] = t.calls;  // their time is not counted: no seconds then
+          if (!t.endless && t.error.empty() && t.calls == 0)
             e["seconds"] = std::round(static_cast<double>(t.frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
         }
       }
@@ -223,7 +236,7 @@ json studio_ops::pull(unsigned slot) {
 
 json studio_ops::check(const std::string& text) {
   const auto d = robot::parse_motion(text, "the motion", m_);
-  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
   const auto c = robot::to_program(d, m_, *o_.layout, period, true);
   json out{{"motion", json::parse(robot::motion_json(d))}, {"yaml", robot::motion_yaml(d)}};
   if (!robot::ok(c)) {
@@ -261,7 +274,7 @@ json studio_ops::push(unsigned slot, const std::string& text, bool dry_run) {
 json studio_ops::play(const std::string& text, client_id from) {
   if (play_) throw studio_refusal("a motion already plays from the host: Stop it first");
   const auto d = robot::parse_motion(text, "the motion", m_);
-  const auto period = s_.run(rcb4::ops::read_config{}).period;
+  const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
   play_ = std::make_unique<sv::host_play>(link_, m_, *o_.layout, period, d, "the motion", true);
   play_start_ = clock::now();
   play_from_ = from;
@@ -298,7 +311,7 @@ std::optional<letter> studio_ops::tick() {
     j["error"] = nullptr;
   } catch (const sv::refused& e) {
     j["error"] = words(e);
-  } catch (const std::system_error& e) {
+  } catch (const std::exception& e) {  // the line (std or boost system_error): the play ends, said
     j["error"] = std::string("the board stopped answering: ") + std::string(plain_message(e.what()));
   }
   play_.reset();
@@ -314,7 +327,7 @@ void studio_ops::stop() {
 
 json studio_ops::buttons() {
   const auto t = sv::read_buttons(link_);
-  const auto cfg = s_.run(rcb4::ops::read_config{});
+  const auto cfg = sv::run(link_, rcb4::ops::read_config{});
   return json{{"ram", entries_json(t.ram.entries, *o_.layout, m_)},
               {"rom", entries_json(t.rom.entries, *o_.layout, m_)},
               {"same", t.same()},
@@ -348,10 +361,14 @@ json studio_ops::hand(const std::string& joint, double degrees) {
 
 json studio_ops::rom_backup() {
   const auto image = sv::backup_rom(link_);
+  const auto version = sv::run(link_, rcb4::ops::read_version{});
+  const auto file = fmt::format("rcb4-rom-{}.bin", sv::file_stamp());
+  // With its .crc32 line, as `rcb4 rom backup` writes it: `rcb4 rom restore FILE` checks the pair.
   return json{{"bytes", image.size()},
               {"crc32", fmt::format("{:08x}", sv::crc32(image))},
+              {"crc32_line", sv::crc32_line(file, image, version)},
               {"base64", base64(image)},
-              {"file", fmt::format("rcb4-rom-{}.bin", sv::file_stamp())}};
+              {"file", file}};
 }
 
 json studio_ops::rom_restore_piece(std::size_t offset, const std::string& base64) {
@@ -375,10 +392,11 @@ json studio_ops::rom_restore_commit(bool force) {
   if (missing)
     throw studio_refusal(fmt::format("the image arrived without {} of its bytes: nothing was written", missing));
   if (const auto crc = sv::crc32(image); crc != upload_crc_)
-    throw studio_refusal(fmt::format("the image's CRC-32 is {:08x}, not the {:08x} the page computed: it was damaged on "
-                                     "the way; nothing was written",
-                                     crc, upload_crc_));
-  const auto version = s_.run(rcb4::ops::read_version{});
+    throw studio_refusal(
+        fmt::format("the image's CRC-32 is {:08x}, not the {:08x} the page computed: it was damaged on "
+                    "the way; nothing was written",
+                    crc, upload_crc_));
+  const auto version = sv::run(link_, rcb4::ops::read_version{});
   const auto r = sv::restore_rom(
       link_, image,
       [&](std::span<const std::uint8_t> now) {

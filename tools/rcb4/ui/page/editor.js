@@ -58,7 +58,9 @@ export function segments(steps, start, limitMs = 120000) {
   const out = [];
   let cur = { ...start }, pc = 0, total = 0, quiet = 0;
   const jump = (to) => { if (!labels.has(to)) throw new Error(`no label called ${to}`); pc = labels.get(to); };
-  while (pc < steps.length && total <= limitMs && quiet < 10000) {
+  for (;;) {
+    if (total > limitMs || quiet >= 10000) { out.endless = true; break; }  // round for ever (or spinning)
+    if (pc >= steps.length) break;
     const s = steps[pc], k = kindOf(s), at = pc;
     pc += 1;
     if (k === 'pose') {
@@ -250,8 +252,9 @@ export function createEditor(root, ctx) {
       return b;
     }));
     const played = segs.reduce((a, g) => a + g.ms, 0);
-    summary.textContent = `${ed.doc.steps.length} steps, ${poses.length} poses; plays ${(played / 1000).toFixed(2)} s` +
-      ' as the board would (loops counted, no button held)';
+    summary.textContent = `${ed.doc.steps.length} steps, ${poses.length} poses; ` + (segs.endless
+      ? 'plays until stopped: it goes round for ever (no button held)'
+      : `plays ${(played / 1000).toFixed(2)} s as the board would (loops counted, no button held)`);
     renderDetail();
     ctx.view?.setGhost(poseAt(ed.sel));
     ctx.controls();

@@ -88,7 +88,7 @@ export function createTables(root, ctx) {
       el('td', { text: String(s.slot) }),
       el('td', { text: s.used ? (s.name || '') + (s.broken ? ' (broken)' : '') : 'free' }),
       el('td', { text: s.used ? String(s.bytes) : '' }),
-      el('td', { text: s.used ? (s.endless ? '∞' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
+      el('td', { text: s.used ? (s.endless ? '∞' : s.calls ? 'calls' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
       el('td', {}, ...(s.used ? [
         bt('', '▶', 'play', () => ask({ op: 'motion_play', slot: s.slot }, `playing motion ${s.slot}`)),
         bt('', '■', 'stop', () => ask({ op: 'motion_stop' }, 'motion stopped')),
@@ -139,10 +139,14 @@ export function createTables(root, ctx) {
     const r = await ask({ op: 'rom_backup' });
     if (!r) return;
     const bytes = Uint8Array.from(atob(r.base64), (c) => c.charCodeAt(0));
-    const a = el('a', { href: URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' })), download: r.file });
-    a.click();
-    setTimeout(() => URL.revokeObjectURL(a.href), 5000);
-    ctx.say(`ROM backed up: ${r.bytes} bytes, CRC-32 ${r.crc32} (${r.file})`);
+    // The image and its .crc32 (as rcb4 rom backup writes them: rcb4 rom restore checks the pair).
+    for (const [blob, name] of [[new Blob([bytes], { type: 'application/octet-stream' }), r.file],
+      [new Blob([r.crc32_line], { type: 'text/plain' }), `${r.file}.crc32`]]) {
+      const a = el('a', { href: URL.createObjectURL(blob), download: name });
+      a.click();
+      setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+    }
+    ctx.say(`ROM backed up: ${r.bytes} bytes, CRC-32 ${r.crc32} (${r.file} and ${r.file}.crc32)`);
   }
 
   // A restore: the image sent in pieces with its CRC-32; the server checks both, then the robot

@@ -43,7 +43,7 @@ class host_play {
    * limit (stopped on the board first).
    */
   std::optional<std::chrono::milliseconds> advance(std::chrono::milliseconds now);
-  /** Interrupted: a ROM motion it called is stopped on the board; the servos stay where they are. */
+  /** Interrupted: a ROM motion it called is stopped on the board, and every servo it moved holds where it is now. */
   void stop();
 
   /** Notes on the file (times rounded to frames, a rescale, steps that never run). */
@@ -68,6 +68,7 @@ class host_play {
   std::chrono::milliseconds ready_{};                      ///< when the board has reached the last pose sent
   std::optional<std::chrono::milliseconds> callee_since_;  ///< a called ROM motion runs, since then
   std::optional<unsigned> callee_;
+  servo_mask moved_;  ///< the servos its poses moved (held where they are when it is stopped)
   bool finished_ = false;
 };
 

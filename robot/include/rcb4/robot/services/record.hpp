@@ -18,6 +18,7 @@
 
 #include <chrono>
 #include <cstddef>
+#include <system_error>
 #include <vector>
 
 namespace rcb4::robot::services {
@@ -37,6 +38,7 @@ struct record_report {
   std::size_t clamped = 0;           ///< angles beyond a limit, kept at the limit
   bool held = false;                 ///< the joints were freed and are held again
   std::chrono::milliseconds span{};  ///< from the first sample to the last
+  std::error_code lost;              ///< set by a driver whose board went away part way (what was kept is above)
 };
 
 /** A recording under way; see the file comment. Destroyed unfinished, it holds what it freed (best effort). */

@@ -34,6 +34,8 @@ std::string implausible_rom(std::span<const std::uint8_t> image);
 /** The CRC-32 (IEEE 802.3, as zlib and `crc32` compute it) of @p bytes: an image file's check. */
 std::uint32_t crc32(std::span<const std::uint8_t> bytes) noexcept;
 
+/** The check line of image file @p name: "crc32  name  N bytes  date  version" (its .crc32 file's text). */
+std::string crc32_line(const std::string& name, std::span<const std::uint8_t> image, const std::string& version);
 /**
  * Writes @p image to @p path and its check line to PATH.crc32 ("crc32  name  N bytes  date
  * version"); a refusal (usage) when either cannot be written.

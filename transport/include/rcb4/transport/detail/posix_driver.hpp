@@ -262,6 +262,7 @@ class posix_driver {
       if (tenths > 0) {
         n = bounded_tty_read(a.in, static_cast<cc_t>(tenths));
         if (n == -2) continue;  // its tenths passed with nothing: the rest of the time goes to ppoll
+        if (n == -3) return {0, transport_errc::settings_not_kept};  // another program cooked the line
       } else {
         error_code ec;
         if (!ready_before(fd, POLLIN, a.deadline, ec, spin_from, spin_until)) return {0, {}, true};
@@ -276,15 +277,20 @@ class posix_driver {
 
   /**
    * A tty read that blocks for at most @p tenths of a second, the terminal's own timer (VMIN 0,
-   * VTIME): -2 when that passed with nothing read, else read()'s result. The descriptor stays
+   * VTIME): -2 when that passed with nothing read, -3 when the line is cooked (ICANON: another
+   * program changed it), else read()'s result. The descriptor stays
    * blocking for the next exchanges on this thread (their writes cannot block: the previous
    * request has left, since its reply came); unpark() makes it non-blocking for the worker.
    */
   ssize_t bounded_tty_read(std::span<std::uint8_t> buf, cc_t tenths) {
     const int fd = fd_.fd;
-    if (fd_.vtime != tenths) {
-      termios t{};
-      if (::tcgetattr(fd, &t) != 0) return -1;
+    // The terminal's settings are read every time: another program (stty, a terminal, pyserial)
+    // may have changed them, and a read on a line no longer set as this one expects would block
+    // for ever (VMIN 1) or until a newline (a cooked line). A cooked line is reported (-3).
+    termios t{};
+    if (::tcgetattr(fd, &t) != 0) return -1;
+    if ((t.c_lflag & ICANON) != 0) return -3;
+    if (t.c_cc[VMIN] != 0 || t.c_cc[VTIME] != tenths || fd_.vtime != tenths) {
       t.c_cc[VMIN] = 0;
       t.c_cc[VTIME] = tenths;
       if (::tcsetattr(fd, TCSANOW, &t) != 0) return -1;
