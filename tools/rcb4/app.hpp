@@ -188,8 +188,8 @@ class progress;
 /** The session as the robot services see it: exchanges, failures as the tool reports them, progress lines. */
 class session_link final : public rcb4::robot::services::link {
  public:
-  /** Over @p s; progress lines unless @p json. */
-  session_link(session& s, bool json) : s_(s), json_(json) {}
+  /** Over @p s; progress lines unless @p json_output. */
+  session_link(session& s, bool json_output) : s_(s), json_(json_output) {}
   ~session_link() override;
   session_link(const session_link&) = delete;
   session_link& operator=(const session_link&) = delete;
