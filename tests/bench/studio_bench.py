@@ -57,8 +57,8 @@ try:
           f"(the page's period {period} ms)")
     if lat:
         print(f"slider -> the board moving the joint: median {statistics.median(lat):.1f} ms, max {max(lat):.1f} ms over {len(lat)} "
-              f"moves (the page gathers moves for 40 ms, the server sends at most one per 40 ms, the board is read every "
-              f"{period} ms)")
+              f"moves (the first move of a drag goes at once, later ones every 40 ms; the board loop takes it at its "
+              f"next cycle and the board is read every {period} ms)")
 finally:
     d.quit()
     ui.stop()

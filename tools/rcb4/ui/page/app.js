@@ -191,17 +191,25 @@ function jointRow(j) {
     ui.dragging.set(j.name, performance.now());
     ui.pendingMoves[j.name] = Number(slider.value);
     target.textContent = `→ ${fmtDeg(Number(slider.value))}`;
-    if (!ui.sendTimer) ui.sendTimer = setTimeout(flushMoves, 40);  // at most 25 messages a second
+    // The first move of a drag goes at once; what follows is gathered: at most 25 messages a second.
+    if (!ui.sendTimer) { sendMoves(); ui.sendTimer = setTimeout(flushMoves, 40); }
   });
   ui.rows.set(j.name, { row, slider, angle, target, marker, j });
   return row;
 }
 
-function flushMoves() {
-  ui.sendTimer = null;
+/** Sends the gathered slider moves, if any; true when it did. */
+function sendMoves() {
   const joints = ui.pendingMoves;
   ui.pendingMoves = {};
-  if (Object.keys(joints).length) ui.ws?.readyState === WebSocket.OPEN && ui.ws.send(JSON.stringify({ op: 'move', joints }));
+  if (!Object.keys(joints).length) return false;
+  if (ui.ws?.readyState === WebSocket.OPEN) ui.ws.send(JSON.stringify({ op: 'move', joints }));
+  return true;
+}
+
+/** Every 40 ms while a drag goes on: what was gathered; with nothing, the next move goes at once. */
+function flushMoves() {
+  ui.sendTimer = sendMoves() ? setTimeout(flushMoves, 40) : null;
 }
 
 function renderState(s) {
