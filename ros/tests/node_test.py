@@ -221,6 +221,18 @@ try:
     srv.terminate()
     srv.wait(timeout=10)
 
+    # An empty ~device is refused (as the tool refuses --device ""), not taken for a simulation.
+    rospy.set_param("/rcb4/device", "")  # as a launch file passing device:="" leaves it
+    empty = start_node()
+    try:
+        empty.wait(timeout=20)
+    except subprocess.TimeoutExpired:
+        empty.kill()
+    said = empty.stdout.read()
+    check(empty.returncode == 1 and "~device is set but empty" in said,
+          f"an empty ~device: exit 1, said ({empty.returncode}: {said.strip()[-160:]!r})")
+    rospy.delete_param("/rcb4/device")
+
     # A board that stops answering, then answers again.
     board = StandIn()
     states.clear()

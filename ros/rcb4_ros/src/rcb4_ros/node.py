@@ -25,7 +25,11 @@ class Rcb4Node:
     (default: one cycle per board output period), ~joint_prefix, ~timeout."""
 
     def __init__(self):
-        self.device = rospy.get_param("~device", "") or None
+        device = rospy.get_param("~device", None)
+        if device is not None and not str(device).strip():
+            # As the tool refuses --device "": an empty device is a mistake, not a wish for a simulation.
+            raise ValueError("~device is set but empty (leave it out for the in-process virtual board)")
+        self.device = str(device) if device is not None else None
         self.baud = int(rospy.get_param("~baud", 0)) or None
         self.robot = rospy.get_param("~robot", "khr-3hv")
         try:
