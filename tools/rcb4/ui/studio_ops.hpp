@@ -67,9 +67,9 @@ class studio_ops {
   std::optional<clock::time_point> play_next_;
   client_id play_from_ = 0;
   std::string play_name_;
-  std::vector<std::uint8_t> upload_;        ///< a ROM image being uploaded (rom_restore_begin … commit)
-  std::vector<bool> uploaded_;              ///< which of its bytes came
-  std::uint32_t upload_crc_ = 0;            ///< the CRC-32 the page says it has
+  std::vector<std::uint8_t> upload_;  ///< a ROM image being uploaded (rom_restore_begin … commit)
+  std::vector<bool> uploaded_;        ///< which of its bytes came
+  std::uint32_t upload_crc_ = 0;      ///< the CRC-32 the page says it has
 };
 
 }  // namespace cli::ui
