@@ -190,10 +190,7 @@ bool sleep_until(std::chrono::steady_clock::time_point t, const std::function<bo
 
 board::file_play board::play_file(const rcb4::robot::motion_document& d, const std::string& name, bool rescale,
                                   double timeout_s, const std::function<bool()>& stop) {
-  // The layout matters only to a call of another motion by number (as the tool decides it).
-  const bool calls = std::any_of(d.steps.begin(), d.steps.end(),
-                                 [](const auto& st) { return std::holds_alternative<rcb4::robot::motion_call>(st); });
-  const auto& layout = calls ? this->layout() : rcb4::hth4_2_2;
+  const auto& layout = sv::needs_layout(d) ? this->layout() : rcb4::hth4_2_2;
   const auto board_period = period();
   const auto stopped = [&] { return closing_ || stop(); };
   return service("play_motion_file", [&](sv::link& l) {

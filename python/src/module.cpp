@@ -7,8 +7,7 @@
 #include <cstdlib>
 #include <map>
 
-#include <rcb4/motion/disassemble.hpp>
-#include <rcb4/motion/player.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
 #include <pybind11/numpy.h>
@@ -353,21 +352,18 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           [](board& b) {
             const std::vector<rcb4::ops::motion_slot> v = unlocked([&] { return b.motions(); });
             const auto period = unlocked([&] { return b.period(); });
+            const auto& layout = unlocked([&]() -> const rcb4::rom_layout& { return b.rom_layout(); });
             const auto names = load_names(b);
             py::list out;
             for (const auto& s : v) {
               const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names);
               // Its seconds as the board plays it (loops counted, no button held), where the steps express it.
               py::object seconds = py::none();
-              if (s.ends) {
-                const rcb4::motion::slot where{rcb4::rom_address::make(s.address).value(), 2048};
-                if (auto p = rcb4::motion::lift(rcb4::motion::disassemble(s.code, where)); rcb4::motion::ok(p)) {
-                  const auto t = rcb4::motion::play_time(std::get<rcb4::motion::program>(p));
-                  if (!t.endless && t.error.empty() && t.calls == 0)
-                    seconds = py::float_(static_cast<double>(t.frames) * rcb4::milliseconds(period) / 1000.0);
-                  else if (t.endless)
-                    seconds = py::float_(std::numeric_limits<double>::infinity());
-                }
+              if (const auto t = rcb4::robot::services::slot_play_time(s, layout)) {
+                if (const auto secs = rcb4::robot::services::play_seconds(*t, period))
+                  seconds = py::float_(*secs);
+                else if (t->endless)
+                  seconds = py::float_(std::numeric_limits<double>::infinity());
               }
               out.append(
                   py::dict("slot"_a = s.number,

@@ -293,6 +293,8 @@ void add_urdf_command(CLI::App& app, context& ctx);    ///< urdf (cmd_urdf.cpp)
 bool wait_for_enter();
 /** The joints the words name (joints, groups, "all"; none: all), each once, in the model's order. */
 std::vector<const rcb4::robot::joint*> joints_of(const rcb4::robot::model& m, const std::vector<std::string>& words);
+/** Refuses (exit 1) naming @p missing, the joints of @p m the board has no servo block for; nothing when none. */
+void refuse_missing(const rcb4::robot::model& m, const std::vector<const rcb4::robot::joint*>& missing);
 /** Where the joints are on this board; joints without a block are an error naming them. */
 rcb4::robot::joint_map locate(session& s, const rcb4::robot::model& m,
                               const std::vector<const rcb4::robot::joint*>& need);

@@ -374,18 +374,10 @@ void add_motion_commands(CLI::App& app, context& ctx) {
     const auto names = rcb4::robot::services::load_slot_names(m.name());
     for (const auto& v : op.value()) {
       const auto name = rcb4::robot::services::slot_name(m, v.number, names);
-      // Its time as the board plays it (loops counted), where the code is one the steps express.
-      std::optional<rcb4::motion::play_estimate> plays;
-      if (v.ends) {
-        const rcb4::motion::slot where{rcb4::rom_address::make(v.address).value(), layout.slot_size};
-        if (auto p = rcb4::motion::lift(rcb4::motion::disassemble(v.code, where)); rcb4::motion::ok(p))
-          plays = rcb4::motion::play_time(std::get<rcb4::motion::program>(p));
-      }
-      // A motion that calls others plays for as long as they do too: not counted here ("calls").
-      const auto seconds = [&]() -> std::optional<double> {
-        if (!plays || plays->endless || !plays->error.empty() || plays->calls) return std::nullopt;
-        return std::round(static_cast<double>(plays->frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
-      }();
+      // Its time as the board plays it (loops counted); one that calls others plays for as long as
+      // they do too: not counted here ("calls").
+      const auto plays = rcb4::robot::services::slot_play_time(v, layout);
+      const auto seconds = plays ? rcb4::robot::services::play_seconds(*plays, period) : std::nullopt;
       const std::string seconds_text = !plays           ? "-"
                                        : plays->endless ? "for ever"
                                        : plays->calls   ? "calls"

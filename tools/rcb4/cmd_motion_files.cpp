@@ -217,10 +217,7 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
   } catch (const ro::profile_error& e) {
     throw usage_error(e.what());
   }
-  // The layout matters only to a call of another motion by number.
-  const bool calls = std::any_of(d.steps.begin(), d.steps.end(),
-                                 [](const auto& st) { return std::holds_alternative<ro::motion_call>(st); });
-  const auto& layout = calls ? layout_for(s, o) : rcb4::hth4_2_2;
+  const auto& layout = sv::needs_layout(d) ? layout_for(s, o) : rcb4::hth4_2_2;
   session_link link(s, g.json);
   sv::host_play play(link, robot, layout, board_period(s), d, file, rescale,
                      std::chrono::milliseconds(static_cast<long long>(o.timeout_s * 1000)));

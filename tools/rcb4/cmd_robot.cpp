@@ -45,17 +45,24 @@ std::vector<const rcb4::robot::joint*> joints_of(const rcb4::robot::model& m, co
   return ordered;
 }
 
+/** Refuses (exit 1) naming @p missing, the joints of @p m the board has no servo block for; nothing when none. */
+void refuse_missing(const rcb4::robot::model& m, const std::vector<const rcb4::robot::joint*>& missing) {
+  if (missing.empty()) return;
+  std::vector<std::string> names;
+  for (const auto* j : missing) names.push_back(fmt::format("{} (ICS {})", j->name, j->ics.value()));
+  throw failure(
+      exit_board, fmt::format("the board has no servo allocated for {}", fmt::join(names, ", ")),
+      fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
+}
+
 /** Where the joints are on this board; joints without a block are an error naming them. */
 rcb4::robot::joint_map locate(session& s, const rcb4::robot::model& m,
                               const std::vector<const rcb4::robot::joint*>& need) {
   auto map = s.run(rcb4::robot::locate_joints(m));
-  std::vector<std::string> missing;
+  std::vector<const rcb4::robot::joint*> missing;
   for (const auto* j : need)
-    if (!map.block_of(*j)) missing.push_back(fmt::format("{} (ICS {})", j->name, j->ics.value()));
-  if (!missing.empty())
-    throw failure(
-        exit_board, fmt::format("the board has no servo allocated for {}", fmt::join(missing, ", ")),
-        fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
+    if (!map.block_of(*j)) missing.push_back(j);
+  refuse_missing(m, missing);
   return map;
 }
 
@@ -464,13 +471,10 @@ void add_trim(CLI::App& app, context& ctx) {
       session s(ctx.g);
       session_link link(s, ctx.g.json);
       const auto trims = rcb4::robot::services::read_trims(link, m, js);
-      std::vector<std::string> missing;
+      std::vector<const rcb4::robot::joint*> missing;
       for (const auto& t : trims)
-        if (!t.allocated) missing.push_back(fmt::format("{} (ICS {})", t.j->name, t.j->ics.value()));
-      if (!missing.empty())
-        throw failure(
-            exit_board, fmt::format("the board has no servo allocated for {}", fmt::join(missing, ", ")),
-            fmt::format("is this a {}? rcb4 scan shows the board's slots; --robot FILE names another robot", m.name()));
+        if (!t.allocated) missing.push_back(t.j);
+      refuse_missing(m, missing);
       json list = json::array();
       for (const auto& t : trims) {
         const auto rom = t.rom_degrees();

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -183,6 +184,19 @@ void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> 
 }
 
 }  // namespace
+
+std::optional<motion::play_estimate> slot_play_time(const ops::motion_slot& s, const rom_layout& layout) {
+  if (!s.ends) return std::nullopt;
+  const mo::slot where{rom_address::make(s.address).value(), layout.slot_size};
+  auto p = mo::lift(mo::disassemble(s.code, where));
+  if (!mo::ok(p)) return std::nullopt;
+  return mo::play_time(std::get<mo::program>(p));
+}
+
+std::optional<double> play_seconds(const motion::play_estimate& e, output_period period) {
+  if (e.endless || !e.error.empty() || e.calls) return std::nullopt;
+  return std::round(static_cast<double>(e.frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
+}
 
 std::string play_time_text(const motion::play_estimate& e, output_period period) {
   if (!e.error.empty()) return "cannot be played: " + e.error;

@@ -5,20 +5,14 @@
 
 #include <catch2/catch.hpp>
 
+#include "profile_error.hpp"
+
 #include <string>
 
 using namespace rcb4::robot;
 
 namespace {
-std::string error_of(const std::string& text) {
-  try {
-    parse_profile(text, "bad.yaml");
-  } catch (const profile_error& e) {
-    return e.what();
-  }
-  FAIL("the profile was accepted:\n" << text);
-  return {};
-}
+std::string error_of(const std::string& text) { return rcb4::test::profile_error_of(text); }
 // Two joints: a knee on a thigh on a body.
 const std::string head =
     "robot: t\n"

@@ -5,6 +5,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "profile_error.hpp"
+
 #include <unistd.h>
 #include <cstdio>
 #include <filesystem>
@@ -14,15 +16,7 @@ using namespace rcb4;
 using namespace rcb4::robot;
 
 namespace {
-std::string error_of(const std::string& text) {
-  try {
-    parse_profile(text, "bad.yaml");
-  } catch (const profile_error& e) {
-    return e.what();
-  }
-  FAIL("the profile was accepted:\n" << text);
-  return {};
-}
+std::string error_of(const std::string& text) { return rcb4::test::profile_error_of(text); }
 const char* two_joints =
     "robot: test\n"
     "joints:\n"

@@ -550,35 +550,6 @@ class loop {
 
 }  // namespace
 
-json body_json(const robot::model& m) {
-  const auto* k = m.body();
-  if (!k) return nullptr;
-  const auto v3 = [](const robot::vec3& v) { return json::array({v[0], v[1], v[2]}); };
-  json links = json::array();
-  for (const auto& l : k->links) {
-    json shapes = json::array();
-    for (const auto& s : l.shapes)
-      shapes.push_back({{"type", s.type == robot::shape::kind::box        ? "box"
-                                 : s.type == robot::shape::kind::cylinder ? "cylinder"
-                                                                          : "sphere"},
-                        {"size", v3(s.size)},
-                        {"xyz", v3(s.xyz)},
-                        {"rpy", v3(s.rpy)}});
-    links.push_back({{"name", l.name}, {"shapes", std::move(shapes)}});
-  }
-  json joints = json::array();
-  for (const auto& j : k->joints)
-    joints.push_back({{"name", j.name},
-                      {"fixed", j.fixed},
-                      {"parent", j.parent},
-                      {"child", j.child},
-                      {"xyz", v3(j.xyz)},
-                      {"rpy", v3(j.rpy)},
-                      {"axis", v3(j.axis)}});
-  return json{
-      {"root", k->root()->name}, {"links", std::move(links)}, {"joints", std::move(joints)}, {"source", k->source}};
-}
-
 void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) { loop(s, m, h, o).run(); }
 
 std::string hello_text(const robot::model& m, const session& s, const loop_options& o, const settings& limits) {

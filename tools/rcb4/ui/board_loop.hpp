@@ -26,9 +26,6 @@ struct loop_options {
  */
 void run_board_loop(session& s, const rcb4::robot::model& m, hub& h, const loop_options& o);
 
-/** The robot's body (the profile's kinematics) for the page's 3D view, or null when the profile has none. */
-json body_json(const rcb4::robot::model& m);
-
 /** The hello every page gets first: the robot (joints, limits, groups, motion names) and the link. */
 std::string hello_text(const rcb4::robot::model& m, const session& s, const loop_options& o, const settings& limits);
 

@@ -102,6 +102,35 @@ json entries_json(const std::vector<rcb4::vector_entry>& entries, const rcb4::ro
 
 }  // namespace
 
+json body_json(const robot::model& m) {
+  const auto* k = m.body();
+  if (!k) return nullptr;
+  const auto v3 = [](const robot::vec3& v) { return json::array({v[0], v[1], v[2]}); };
+  json links = json::array();
+  for (const auto& l : k->links) {
+    json shapes = json::array();
+    for (const auto& s : l.shapes)
+      shapes.push_back({{"type", s.type == robot::shape::kind::box        ? "box"
+                                 : s.type == robot::shape::kind::cylinder ? "cylinder"
+                                                                          : "sphere"},
+                        {"size", v3(s.size)},
+                        {"xyz", v3(s.xyz)},
+                        {"rpy", v3(s.rpy)}});
+    links.push_back({{"name", l.name}, {"shapes", std::move(shapes)}});
+  }
+  json joints = json::array();
+  for (const auto& j : k->joints)
+    joints.push_back({{"name", j.name},
+                      {"fixed", j.fixed},
+                      {"parent", j.parent},
+                      {"child", j.child},
+                      {"xyz", v3(j.xyz)},
+                      {"rpy", v3(j.rpy)},
+                      {"axis", v3(j.axis)}});
+  return json{
+      {"root", k->root()->name}, {"links", std::move(links)}, {"joints", std::move(joints)}, {"source", k->source}};
+}
+
 studio_ops::studio_ops(session& s, const robot::model& m, const loop_options& o)
     : s_(s), m_(m), o_(o), link_(s, true) {}
 
@@ -112,21 +141,26 @@ studio_ops::~studio_ops() {
   }
 }
 
+std::string studio_ops::backup_path(const std::string& what) const {
+  const auto dir = o_.poses / "backups";
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);  // a folder that cannot be made: the save says why
+  return (dir / fmt::format("{}-{}.bin", what, sv::file_stamp())).string();
+}
+
 json studio_ops::act(const studio_action& a, client_id from) {
   const auto args = json::parse(a.args, nullptr, false);
   const auto slot = [&] { return args.at("slot").get<unsigned>(); };
-  const auto backup = [&](unsigned n, std::span<const std::uint8_t> old) {
-    const auto dir = o_.poses / "backups";
-    std::error_code ec;
-    std::filesystem::create_directories(dir, ec);
-    return sv::save_backup_file(n, old, (dir / fmt::format("motion-{}-{}.bin", n, sv::file_stamp())).string());
+  const sv::backup_sink backup = [this](unsigned n, std::span<const std::uint8_t> old) {
+    return sv::save_backup_file(n, old, backup_path(fmt::format("motion-{}", n)));
   };
   try {
     const auto& op = a.op;
     if (op == "motion_list") return list();
     if (op == "motion_pull") return pull(slot());
     if (op == "motion_check") return check(args.at("text").get<std::string>());
-    if (op == "motion_push") return push(slot(), args.at("text").get<std::string>(), args.value("dry_run", false));
+    if (op == "motion_push")
+      return push(slot(), args.at("text").get<std::string>(), args.value("dry_run", false), backup);
     if (op == "motion_erase") {
       const auto r = sv::erase_motion(link_, *o_.layout, slot(), backup, m_.name());
       return json{{"slot", r.motion}, {"unchanged", r.unchanged}, {"backup", r.backup}};
@@ -208,15 +242,10 @@ json studio_ops::list() {
       e["commands"] = it->frames;
       e["broken"] = !it->ends || !it->readable;
       e["seconds"] = nullptr;
-      if (it->ends) {
-        const mo::slot where{rcb4::rom_address::make(it->address).value(), layout.slot_size};
-        if (auto p = mo::lift(mo::disassemble(it->code, where)); mo::ok(p)) {
-          const auto t = mo::play_time(std::get<mo::program>(p));
-          e["endless"] = t.endless;
-          e["calls"] = t.calls;  // their time is not counted: no seconds then
-          if (!t.endless && t.error.empty() && t.calls == 0)
-            e["seconds"] = std::round(static_cast<double>(t.frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
-        }
+      if (const auto t = sv::slot_play_time(*it, layout)) {
+        e["endless"] = t->endless;
+        e["calls"] = t->calls;  // their time is not counted: no seconds then
+        if (const auto s = sv::play_seconds(*t, period)) e["seconds"] = *s;
       }
     }
     slots.push_back(std::move(e));
@@ -252,20 +281,12 @@ json studio_ops::check(const std::string& text) {
   return out;
 }
 
-json studio_ops::push(unsigned slot, const std::string& text, bool dry_run) {
+json studio_ops::push(unsigned slot, const std::string& text, bool dry_run, const sv::backup_sink& backup) {
   sv::push_source src;
   src.document = robot::parse_motion(text, "the motion", m_);
   src.name = "the motion";
   src.rescale = true;  // the editor's times are milliseconds, whatever the board's period
-  const auto r = sv::push_motion(
-      link_, m_, *o_.layout, slot, src,
-      [&](unsigned n, std::span<const std::uint8_t> old) {
-        const auto dir = o_.poses / "backups";
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        return sv::save_backup_file(n, old, (dir / fmt::format("motion-{}-{}.bin", n, sv::file_stamp())).string());
-      },
-      dry_run);
+  const auto r = sv::push_motion(link_, m_, *o_.layout, slot, src, backup, dry_run);
   return json{{"slot", r.motion},         {"address", r.address}, {"bytes", r.bytes.size()},
               {"unchanged", r.unchanged}, {"dry_run", r.dry_run}, {"backup", r.backup},
               {"summary", r.summary},     {"notes", r.notes},     {"name", r.name}};
@@ -400,10 +421,7 @@ json studio_ops::rom_restore_commit(bool force) {
   const auto r = sv::restore_rom(
       link_, image,
       [&](std::span<const std::uint8_t> now) {
-        const auto dir = o_.poses / "backups";
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        const auto path = (dir / fmt::format("rom-before-restore-{}.bin", sv::file_stamp())).string();
+        const auto path = backup_path("rom-before-restore");
         sv::save_rom_image(path, now, version);
         return path;
       },

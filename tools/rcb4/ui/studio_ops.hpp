@@ -10,6 +10,7 @@
 #include "controller.hpp"
 
 #include <rcb4/robot/services/host_play.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 
 #include <chrono>
 #include <memory>
@@ -19,6 +20,9 @@
 #include <vector>
 
 namespace cli::ui {
+
+/** The robot's body (the profile's kinematics) for the page's 3D view, or null when the profile has none. */
+json body_json(const rcb4::robot::model& m);
 
 /** A studio op that did not do what it was asked: the words for the page (nothing was changed unless they say so). */
 struct studio_refusal : std::runtime_error {
@@ -49,12 +53,14 @@ class studio_ops {
   json list();
   json pull(unsigned slot);
   json check(const std::string& text);
-  json push(unsigned slot, const std::string& text, bool dry_run);
+  json push(unsigned slot, const std::string& text, bool dry_run, const rcb4::robot::services::backup_sink& backup);
   json play(const std::string& text, client_id from);
   json buttons();
   json trims();
   json hand(const std::string& joint, double degrees);
   json rom_backup();
+  /** Where a backup of @p what ("motion-10") goes: POSES/backups/WHAT-DATE.bin (the folder made). */
+  std::string backup_path(const std::string& what) const;
   json rom_restore_piece(std::size_t offset, const std::string& base64);
   json rom_restore_commit(bool force);
 

@@ -23,6 +23,16 @@
 
 namespace rcb4::robot::services {
 
+/**
+ * True when @p d calls a ROM motion (its slot's address depends on the board's HTH4 layout): only
+ * then must a front end tell the layout from the ROM before a play from the host.
+ */
+inline bool needs_layout(const motion_document& d) {
+  for (const auto& st : d.steps)
+    if (std::holds_alternative<motion_call>(st)) return true;
+  return false;
+}
+
 /** A motion file played from the host; see the file comment. */
 class host_play {
  public:

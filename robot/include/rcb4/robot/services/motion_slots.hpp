@@ -17,6 +17,7 @@
 
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/motion/player.hpp>
+#include <rcb4/ops/survey.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/link.hpp>
 
@@ -56,6 +57,18 @@ std::size_t code_size(const motion::listing& code);
  * 2.10 s and 1 call of other motions, no button held", "plays until stopped: ...".
  */
 std::string play_time_text(const motion::play_estimate& e, output_period period);
+
+/**
+ * How long a slot ops::list_motions walked plays as the board runs it (loops counted, no button
+ * held), when it ends and its code is one the steps express; nothing otherwise.
+ */
+std::optional<motion::play_estimate> slot_play_time(const ops::motion_slot& s, const rom_layout& layout);
+
+/**
+ * @p e's seconds at @p period, to the hundredth; nothing when it goes round for ever, cannot be
+ * played, or calls other motions (whose time it does not count).
+ */
+std::optional<double> play_seconds(const motion::play_estimate& e, output_period period);
 
 /** What a push did. */
 struct push_report {
