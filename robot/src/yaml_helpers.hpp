@@ -9,6 +9,8 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -108,6 +110,16 @@ inline void check_keys(const std::string& source, const YAML::Node& map,
       fail(source, kv.first, what + ": '" + k + "' is given twice");
     seen.push_back(k);
   }
+}
+
+/** A motion file's words for an if_ram comparison, in motion::compare's order. */
+inline constexpr std::string_view compares[] = {"equal", "not_equal", "below", "at_least"};
+
+/** @p v as "0x" and @p digits hexadecimal digits ("0x000B80"). */
+inline std::string hex(std::uint32_t v, int digits) {
+  char b[16];
+  std::snprintf(b, sizeof b, "0x%0*X", digits, static_cast<unsigned>(v));
+  return b;
 }
 
 /** A profile's `kinematics:` node, checked against the profile's joints; a profile_error at the entry at fault. */
