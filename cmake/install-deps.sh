@@ -11,6 +11,7 @@ packages=(
   libboost1.81-dev                     # Boost.Asio for transport/ (1.74's Asio breaks under GCC 12 in C++20)
   libcli11-dev nlohmann-json3-dev      # the rcb4 tool's arguments and JSON
   libyaml-cpp-dev                      # robot profiles and pose files (rcb4::profile)
+  libpugixml-dev                       # HeartToHeart4 projects, motion and trim files (rcb4::profile's hth4 readers)
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # the codec built for firmware
   qemu-system-arm                      # runs the example firmware (examples/firmware) in the suite
   python3                              # a client in another language for the virtual board tests

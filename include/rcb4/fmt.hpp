@@ -97,6 +97,7 @@ Out write_cond(Out out, const condition& c) {
   if (!c.zero && !c.carry) return out;
   out = fmt::format_to(out, " if");
   if (c.zero) out = fmt::format_to(out, " Z={}", *c.zero ? 1 : 0);
+  if (c.zero && c.carry) out = fmt::format_to(out, " {}", two_flag_jump == two_flag_rule::either ? "or" : "and");
   if (c.carry) out = fmt::format_to(out, " C={}", *c.carry ? 1 : 0);
   return out;
 }

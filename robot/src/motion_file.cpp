@@ -181,7 +181,7 @@ motion_step parse_step(const std::string& source, const YAML::Node& n, const mod
                                       kind == "if_buttons");
   }
   if (kind == "if_ram") {
-    check_keys(source, n, {"if_ram", "size", "equal", "not_equal", "below", "at_least", "goto"}, kind);
+    check_keys(source, n, {"if_ram", "size", "equal", "not_equal", "below", "at_least", "at_most", "goto"}, kind);
     if (!n["goto"]) fail(source, n, "if_ram: goto names the label to jump to");
     if (!n["size"]) fail(source, n, "if_ram: size says whether the value is 1 or 2 bytes");
     motion::branch_if b;
@@ -195,7 +195,7 @@ motion_step parse_step(const std::string& source, const YAML::Node& n, const mod
         b.value =
             static_cast<std::uint16_t>(integer(source, c, std::string(compares[i]), 0, b.size == 1 ? 0xFF : 0xFFFF));
       }
-    if (given != 1) fail(source, n, "if_ram: one of equal, not_equal, below, at_least gives the value to compare with");
+    if (given != 1) fail(source, n, "if_ram: one of equal, not_equal, below, at_least, at_most gives the value to compare with");
     b.to = label_name(source, n["goto"], "goto");
     return b;
   }

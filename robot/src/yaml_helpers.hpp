@@ -113,7 +113,7 @@ inline void check_keys(const std::string& source, const YAML::Node& map,
 }
 
 /** A motion file's words for an if_ram comparison, in motion::compare's order. */
-inline constexpr std::string_view compares[] = {"equal", "not_equal", "below", "at_least"};
+inline constexpr std::string_view compares[] = {"equal", "not_equal", "below", "at_least", "at_most"};
 
 /** @p v as "0x" and @p digits hexadecimal digits ("0x000B80"). */
 inline std::string hex(std::uint32_t v, int digits) {

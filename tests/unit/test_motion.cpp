@@ -186,3 +186,42 @@ TEST_CASE("motion: the virtual board runs an assembled motion as a board does", 
   CHECK(w.read_word(0x0090 + 4) == 6500);  // and its last
   CHECK(w.read_ram(0x0457, 1)[0] == 0);    // the counter ran down
 }
+
+// HTH4's CmpAD block (hth4-files.md §5.5): SUB flags-only AD2 (RAM 0x0026) − 300, then a JUMP with
+// COND 0D for "≤": the frames written from the spec, assembled from an at_most step, read back,
+// and run on the virtual board (taken when AD2 ≤ 300 under the "either" rule, §8).
+TEST_CASE("motion: at_most is HTH4's AD <= limit compare (COND 0D)", "[motion][board]") {
+  const program p{{branch_if{ram_address{0x0026}, 2, 300, compare::at_most, "low"}, set_counter{hth4_counter, 1}, end{},
+                   label{"low"}, set_counter{hth4_counter, 2}, end{}}};
+  const auto b = assemble(p, slot_of(hth4_2_2, 5).value());
+  REQUIRE(ok(b));
+  const auto& bytes = std::get<std::vector<std::uint8_t>>(b);
+  // 0x2B80 SUB (9), 0x2B89 JUMP (7), 0x2B90 MOV (8), 0x2B98 RETURN (3), 0x2B9B "low".
+  const std::vector<std::uint8_t> head = {
+      0x09, 0x07, 0x82, 0x26, 0x00, 0x00, 0x2C,
+      0x01, 0xE5,  // §5.5, as printed
+      0x07, 0x0B, 0x9B, 0x2B, 0x00, 0x0D, static_cast<std::uint8_t>(0x07 + 0x0B + 0x9B + 0x2B + 0x0D)};
+  REQUIRE(bytes.size() > head.size());
+  CHECK(std::vector<std::uint8_t>(bytes.begin(), bytes.begin() + 16) == head);
+  const auto back = lift(disassemble(bytes, slot_of(hth4_2_2, 5).value()));
+  REQUIRE(ok(back));
+  CHECK(std::get<branch_if>(std::get<program>(back).steps[0]).how == compare::at_most);
+  // Run on the virtual board with a noiseless 1-byte value (C2, 0x0458) against 10: §8's test.
+  const program q{{branch_if{ram_address{0x0458}, 1, 10, compare::at_most, "low"}, set_counter{hth4_counter, 1}, end{},
+                   label{"low"}, set_counter{hth4_counter, 2}, end{}}};
+  const auto qb = assemble(q, slot_of(hth4_2_2, 5).value());
+  REQUIRE(ok(qb));
+  for (const auto& [c2, counter] : {std::pair{5, 2}, std::pair{10, 2}, std::pair{20, 1}}) {
+    board_wire w;
+    ops::write_memory wr(ops::memory::rom, 0x002B80, std::get<std::vector<std::uint8_t>>(qb));
+    rcb4::testing::run(w, wr);
+    REQUIRE(wr.error() == errc{});
+    REQUIRE(w.write_ram(0x0458, {static_cast<std::uint8_t>(c2)}).is_ack());
+    ops::play_motion play(5);
+    rcb4::testing::run(w, play);
+    REQUIRE(play.error() == errc{});
+    w.wait(100ms);
+    INFO("C2 " << c2);
+    CHECK(w.read_ram(0x0457, 1)[0] == (two_flag_jump == two_flag_rule::either ? counter : 1));
+  }
+}

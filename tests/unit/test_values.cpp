@@ -58,7 +58,7 @@ TEST_CASE("formatters describe commands for a person", "[fmt]") {
         "SINGLE ICS 5 → FREE in 0 frames (leave update flags)");
   CHECK(fmt::format("{}", command{move::read_ram(0x0000, 2).value()}) == "MOV RAM[0x0000+2] → COM");
   CHECK(fmt::format("{}", command{call{0x000B80}}) == "CALL 0x000B80");
-  CHECK(fmt::format("{}", command{jump{0x001000, condition{true, false}}}) == "JUMP 0x001000 if Z=1 C=0");
+  CHECK(fmt::format("{}", command{jump{0x001000, condition{true, false}}}) == "JUMP 0x001000 if Z=1 or C=0");
   CHECK(fmt::format("{}", command{const_servo::make({{3, 8000}, {1, servo_position::hold()}}, 20).value()}) ==
         "CONST 2 servos in 20 frames: 1=HOLD 3=8000");
   CHECK(fmt::format("{}", command{shift::make(destination::ram(0x0090), -2, 1).value()}) ==

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <string>
+#include <tuple>
+
 using namespace rcb4;
 using namespace std::chrono_literals;
 using rcb4::testing::board_wire;
@@ -176,6 +179,43 @@ TEST_CASE("board: JUMP, CALL and RETURN with conditions and a 16-deep stack", "[
   CHECK(config_word::decode(v.read_word(0)).rom_program);
   CHECK(v.send(ret{}).is_ack());
   CHECK_FALSE(config_word::decode(v.read_word(0)).rom_program);
+}
+
+// hth4-files.md §8: after a flags-only SUB of C1 − 10 (Z = 1 equal, C = 0 on a borrow), COND 0D
+// and 0F with C1 = 5, 10, 20 — the hardware test of §8 run on the virtual board. "Either" (what
+// rcb4 follows, two_flag_jump) predicts taken, taken, not for 0D (≤) and not, taken, taken for 0F
+// (≥); "both" predicts not, not, not and not, taken, not.
+TEST_CASE("board: a JUMP comparing two flags is taken when either matches (hth4-files.md 8)", "[board][flow]") {
+  static_assert(condition::decode(0x0D).value() == condition{true, false});
+  static_assert(condition::decode(0x0F).value() == condition{true, true});
+  const bool either = two_flag_jump == two_flag_rule::either;
+  for (const auto& [c1, le, ge] :
+       {std::tuple{5, true, false}, std::tuple{10, true, true}, std::tuple{20, false, true}}) {
+    for (const std::uint8_t cond : {std::uint8_t{0x0D}, std::uint8_t{0x0F}}) {
+      board_wire w;
+      REQUIRE(w.write_ram(0x0000, {0x00, 0x00}).is_ack());  // the ROM program suspended: the PC stays
+      REQUIRE(w.write_ram(0x0457, {static_cast<std::uint8_t>(c1)}).is_ack());
+      CHECK(w.send(jump{0x001000}).is_ack());
+      REQUIRE(
+          w.send(arith::make(arith_op::sub, destination::ram(0x0457), source::literal_u8(10), store_mode::flags_only)
+                     .value())
+              .kind() == reply_kind::data);
+      CHECK(w.send(jump{0x002000, condition::decode(cond).value()}).is_ack());
+      const auto b = w.read_ram(0x0002, 3);
+      const bool taken = (b[0] | (b[1] << 8) | (b[2] << 16)) == 0x002000;
+      const bool expected = either ? (cond == 0x0D ? le : ge) : (cond == 0x0D ? false : c1 == 10);
+      INFO("C1 " << c1 << ", COND " << int(cond));
+      CHECK(taken == expected);
+    }
+  }
+  // The relation each condition tests, in one table.
+  CHECK(std::string(condition::decode(0x0D).value().relation()) == (either ? "<=" : "never"));
+  CHECK(std::string(condition::decode(0x0F).value().relation()) == (either ? ">=" : "=="));
+  CHECK(std::string(condition::decode(0x05).value().relation()) == "==");
+  CHECK(std::string(condition::decode(0x04).value().relation()) == "!=");
+  CHECK(std::string(condition::decode(0x08).value().relation()) == "<");
+  CHECK(std::string(condition::decode(0x0A).value().relation()) == ">=");
+  CHECK(std::string(condition::always().relation()) == "always");
 }
 
 TEST_CASE("board: SINGLE and CONST interpolate over frames, FREE and HOLD", "[board][servo]") {

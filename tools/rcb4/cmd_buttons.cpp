@@ -40,12 +40,7 @@ std::string operand_text(rcb4::vector_operand o) {
   return o.is_ics() ? fmt::format("ICS {} +{}", o.ics_slot(), o.address()) : fmt::format("RAM 0x{:04X}", o.address());
 }
 
-std::string condition_text(const rcb4::condition& c) {
-  if (!c.zero && !c.carry) return "always";
-  if (c.zero && c.carry) return *c.zero ? (*c.carry ? "==" : "never") : (*c.carry ? ">" : "<");
-  if (c.zero) return *c.zero ? "==" : "!=";
-  return *c.carry ? ">=" : "<";
-}
+std::string condition_text(const rcb4::condition& c) { return c.relation(); }
 
 /** What an entry does, in words. */
 std::string entry_text(const rcb4::vector_entry& e, const rcb4::rom_layout& layout, const rcb4::robot::model& robot) {

@@ -16,6 +16,25 @@
 
 namespace rcb4 {
 
+/**
+ * How the board takes a JUMP/CALL whose COND compares both flags: when either compared flag has
+ * its required value, or only when both do. DOC-CMD p13 defines the COND bits but not this.
+ * Evidence (hth4-files.md §8; motions.md §0 sources): KONDO's own KXR get-up motion branches
+ * after a flags-only SUB of an AD channel minus a limit (Z = 1 equal, C = 0 on a borrow,
+ * protocol.md §5) with COND 0D on the blocks HTH4 labels "≤" and 0F on those labelled "≥". Read
+ * as "both", 0D (Z = 1 and C = 0) could never be taken and 0F only on equality; read as
+ * "either", 0D is ≤ and 0F is ≥, as labelled, and no other sample (one flag compared) tells the
+ * two apart. So: either, an inference from KONDO's own output, not yet seen on a board. The
+ * hardware test of hth4-files.md §8 settles it; build with -DRCB4_JUMP_NEEDS_BOTH_FLAGS=1 to
+ * flip the codec, the virtual board, the disassembler and the vector table together.
+ */
+enum class two_flag_rule : std::uint8_t { either, both };
+#if defined(RCB4_JUMP_NEEDS_BOTH_FLAGS) && RCB4_JUMP_NEEDS_BOTH_FLAGS
+inline constexpr two_flag_rule two_flag_jump = two_flag_rule::both;
+#else
+inline constexpr two_flag_rule two_flag_jump = two_flag_rule::either;  ///< the rule this build follows
+#endif
+
 /** When JUMP/CALL is taken: each flag either ignored or required to have a value. */
 struct condition {
   std::optional<bool> zero;   ///< required Z flag, or not compared
@@ -40,8 +59,20 @@ struct condition {
     if (b & 0x08u) c.carry = (b & 0x02u) != 0;
     return c;
   }
-  /** True when flags @p z and @p c satisfy the condition. */
-  constexpr bool holds(bool z, bool c) const noexcept { return (!zero || *zero == z) && (!carry || *carry == c); }
+  /** True when flags @p z and @p c satisfy the condition (two compared flags: two_flag_jump). */
+  constexpr bool holds(bool z, bool c) const noexcept {
+    if (zero && carry && two_flag_jump == two_flag_rule::either) return *zero == z || *carry == c;
+    return (!zero || *zero == z) && (!carry || *carry == c);
+  }
+  /**
+   * What the condition tests after a flags-only SUB of a left minus a right value: "always",
+   * "never", "==", "!=", "<", "<=", ">", ">=" (Z = 1 when equal, C = 0 on a borrow).
+   */
+  constexpr const char* relation() const noexcept {
+    const unsigned less = holds(false, false), equal = holds(true, true), greater = holds(false, true);
+    constexpr const char* names[] = {"never", ">", "==", ">=", "<", "!=", "<=", "always"};
+    return names[less * 4 + equal * 2 + greater];
+  }
   friend constexpr bool operator==(const condition&, const condition&) noexcept = default;
 };
 

@@ -24,6 +24,7 @@ inline condition condition_of(compare how) noexcept {
     case compare::not_equal: return {false, std::nullopt};
     case compare::below: return {std::nullopt, false};
     case compare::at_least: return {std::nullopt, true};
+    case compare::at_most: return {true, false};
   }
   return {};
 }

@@ -111,17 +111,29 @@ inline outcome<std::uint16_t> parse_buttons(std::string_view text) {
   return word;
 }
 
-/** An entry that can never fire (Z = 1 with C = 0 cannot follow a compare), marked EOF: an empty table. */
+/**
+ * An entry that can never fire, marked EOF: an empty table. It compares the button word with the
+ * literal 0 and fires on a borrow (C = 0 alone), which an unsigned value minus 0 never has, under
+ * either rule for two flags (rcb4::two_flag_jump). Bytes: F8 50 03 00 00 00 00 00 (EOF 80, JUMP
+ * 40, WORD 20, literal 10, compare C 08, C = 0). rcb4 before 0.2 wrote Z = 1 and C = 0 (FD …),
+ * which under the "either" rule fires whenever no button is held: never_fires() does not hide it
+ * then, so `motion buttons` lists it and `motion buttons reset` replaces it.
+ */
 constexpr vector_entry never_entry() noexcept {
   vector_entry e;
   e.dst = vector_operand::ram(krr::buttons);
-  e.cond = condition{true, false};
+  e.cond = condition{std::nullopt, false};
+  e.src_literal = true;
+  e.src = 0;
   e.action = vector_action::jump;
   e.last = true;
   return e;
 }
-/** True for never_entry()'s condition (whatever its operands). */
-constexpr bool never_fires(const vector_entry& e) noexcept { return e.cond == condition{true, false}; }
+/** True for an entry that cannot fire: never_entry()'s test (any destination), or rcb4 0.1's under the "both" rule. */
+constexpr bool never_fires(const vector_entry& e) noexcept {
+  if (e.cond == condition{std::nullopt, false} && e.src_literal && e.src == 0) return true;
+  return two_flag_jump == two_flag_rule::both && e.cond == condition{true, false};
+}
 
 /** A table as read: its entries in order, and why the walk ended. */
 struct vector_table {

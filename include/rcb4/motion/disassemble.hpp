@@ -122,7 +122,7 @@ inline std::uint16_t literal_value(const source& s) {
 }
 /** The compare a JUMP condition after a flags-only SUB tests, if it is one of the four. */
 inline std::optional<compare> compare_of(const condition& c) {
-  for (auto how : {compare::equal, compare::not_equal, compare::below, compare::at_least})
+  for (auto how : {compare::equal, compare::not_equal, compare::below, compare::at_least, compare::at_most})
     if (condition_of(how) == c) return how;
   return std::nullopt;
 }
@@ -173,7 +173,7 @@ inline outcome<program> lift(const listing& l) {
         p.steps.push_back(count_down{at, to, *cond.zero});
       } else {
         const auto how = detail::compare_of(then->cond());
-        if (!how) return cannot("a compare with a condition that is not one of equal, not equal, below, at least");
+        if (!how) return cannot("a compare with a condition that is not one of equal, not equal, below, at least, at most");
         p.steps.push_back(branch_if{at, a->src().size(), detail::literal_value(a->src()), *how, to});
       }
       ++i;  // the JUMP belongs to this step

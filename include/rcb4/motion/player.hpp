@@ -148,6 +148,7 @@ class player {
       case compare::not_equal: jump = v != b.value; break;
       case compare::below: jump = v < b.value; break;
       case compare::at_least: jump = v >= b.value; break;
+      case compare::at_most: jump = v <= b.value; break;
     }
     if (jump) pc_ = labels_.at(b.to);
   }

@@ -74,6 +74,7 @@ enum class compare : std::uint8_t {
   not_equal,  ///< Z = 0
   below,      ///< C = 0 (a borrow)
   at_least,   ///< C = 1
+  at_most,    ///< Z = 1 or C = 0: COND 0D, HTH4's "≤" (rcb4::two_flag_jump: either flag)
 };
 /** A jump to @p to when the 1- or 2-byte RAM value at @p address compares so with @p value. */
 struct branch_if {

@@ -21,7 +21,7 @@
 //     - if_buttons: up              # KRR buttons equal (unless_buttons: differ); goto: a label
 //       goto: again
 //     - if_ram: 0x0460              # any 1- or 2-byte RAM value: equal, not_equal, below,
-//       size: 1                     # at_least a literal
+//       size: 1                     # at_least, at_most a literal
 //       equal: 3
 //       goto: done
 //     - stretch: {legs: 60, head_yaw: 127}  # or speed:; joints, groups, "all", "ics N": 1..127

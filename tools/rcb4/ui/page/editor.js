@@ -82,7 +82,7 @@ export function segments(steps, start, limitMs = 120000) {
     else if (k === 'if_ram') {
       const v = 0;
       if (('equal' in s && v === s.equal) || ('not_equal' in s && v !== s.not_equal) || ('below' in s && v < s.below) ||
-        ('at_least' in s && v >= s.at_least)) jump(s.goto);
+        ('at_least' in s && v >= s.at_least) || ('at_most' in s && v <= s.at_most)) jump(s.goto);
     }
   }
   return out;
