@@ -288,6 +288,8 @@ void add_robot_commands(CLI::App& app, context& ctx);  ///< joint, pose, trim, s
 void add_ui_command(CLI::App& app, context& ctx);      ///< ui (cmd_ui.cpp, ui/)
 void add_rom_commands(CLI::App& app, context& ctx);    ///< rom backup|restore (cmd_rom.cpp)
 void add_urdf_command(CLI::App& app, context& ctx);    ///< urdf (cmd_urdf.cpp)
+void add_project_commands(CLI::App& app, context& ctx);  ///< project import|export (cmd_project.cpp)
+void add_trim_import(CLI::App* trim, context& ctx);      ///< trim import (cmd_project.cpp)
 // Shared by the robot commands (cmd_robot.cpp) and motion record (cmd_record.cpp).
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
 bool wait_for_enter();

@@ -494,6 +494,7 @@ void add_trim(CLI::App& app, context& ctx) {
       return exit_ok;
     };
   });
+  add_trim_import(trim, ctx);
   auto* set = trim->add_subcommand("set", "set trims: NAME=DEG ... (within ±30 deg)");
   struct set_options {
     std::vector<std::string> items;

@@ -94,4 +94,48 @@ trims_report set_trims(link& l, const model& robot, const std::vector<std::pair<
   return {std::move(trims), persistent};
 }
 
+ics_trims_report set_ics_trims(link& l, const std::vector<std::pair<unsigned, std::int16_t>>& trims, bool persistent) {
+  std::vector<unsigned> seen;
+  for (const auto& [ics, counts] : trims) {
+    if (ics >= 36)
+      throw refused(refusal_kind::usage, fmt::format("ICS {} does not exist (0..35; nothing written)", ics));
+    if (std::find(seen.begin(), seen.end(), ics) != seen.end())
+      throw refused(refusal_kind::usage, fmt::format("ICS {} is given twice (nothing written)", ics));
+    seen.push_back(ics);
+  }
+  const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 72));
+  ics_trims_report r;
+  r.persistent = persistent;
+  try {
+    for (const auto& [ics, counts] : trims) {
+      const auto block = static_cast<std::uint16_t>(table[2 * ics] | (table[2 * ics + 1] << 8));
+      if (block == rcb4::ram::no_allocation || block < rcb4::ram::user_area.value()) {
+        r.skipped.push_back({ics, counts});
+        continue;
+      }
+      const auto at = static_cast<std::uint16_t>(block + 2);
+      const auto u = static_cast<std::uint16_t>(counts);
+      const std::uint8_t bytes[] = {static_cast<std::uint8_t>(u), static_cast<std::uint8_t>(u >> 8)};
+      run(l, rcb4::ops::write_memory(memory::ram, at, bytes));
+      if (persistent) run(l, rcb4::ops::write_memory(memory::rom, hth4_rom::servo_image_of(at).value(), bytes));
+      const auto ram = word_at(run(l, rcb4::ops::read_memory(memory::ram, at, 2)), 0);
+      const auto rom =
+          persistent ? word_at(run(l, rcb4::ops::read_memory(memory::rom, hth4_rom::servo_image_of(at).value(), 2)), 0)
+                     : counts;
+      if (ram != counts || rom != counts)
+        throw refused(refusal_kind::board,
+                      fmt::format("ICS {}: trim {:+d} written, but the board reads back {:+d} (RAM){}", ics, counts,
+                                  ram, persistent ? fmt::format(", {:+d} (ROM)", rom) : std::string()));
+      r.written.push_back({ics, counts});
+    }
+  } catch (const std::system_error& e) {
+    if (r.written.empty()) throw;
+    std::vector<std::string> done;
+    for (const auto& [ics, counts] : r.written) done.push_back(fmt::format("ICS {} {:+d}", ics, counts));
+    throw refused(refusal_kind::line, fmt::format("{} (already written: {})", e.what(), fmt::join(done, ", ")), {}, {},
+                  e.code());
+  }
+  return r;
+}
+
 }  // namespace rcb4::robot::services

@@ -50,4 +50,20 @@ struct trims_report {
 trims_report set_trims(link& l, const model& robot, const std::vector<std::pair<std::string, double>>& trims,
                        bool persistent);
 
+/** What set_ics_trims wrote. */
+struct ics_trims_report {
+  std::vector<std::pair<unsigned, std::int16_t>> written;  ///< ICS number, counts: RAM (and ROM), read back
+  std::vector<std::pair<unsigned, std::int16_t>> skipped;  ///< servos the board has no block for
+  bool persistent = false;                                 ///< also in ROM
+};
+
+/**
+ * Writes trims by ICS number in counts (an HTH4 trim file's entries, hth4-files.md §6) to the
+ * blocks the board's allocation table names: RAM, and with @p persistent ROM's servo image (for
+ * blocks in the user area); each read back. An ICS number the board does not allocate is
+ * skipped and listed, nothing written for it. Refused (usage) for an ICS number given twice or
+ * beyond 35; a line that fails part way names what was written.
+ */
+ics_trims_report set_ics_trims(link& l, const std::vector<std::pair<unsigned, std::int16_t>>& trims, bool persistent);
+
 }  // namespace rcb4::robot::services

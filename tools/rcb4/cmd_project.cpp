@@ -1,0 +1,201 @@
+// rcb4 command-line tool: HeartToHeart4 files (hth4-files.md). project import FILE.h4p [--dry-run]
+// puts a project on the board as HTH4's "write to robot" would, as far as its bytes are known;
+// project export FILE.h4p writes the board as a project; trim import FILE.h4t writes a trim file's
+// trims by ICS number. The work is in the robot services (rcb4/robot/services/project.hpp, trims.hpp).
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <rcb4/robot/hth4/project.hpp>
+#include <rcb4/robot/hth4/trim_file.hpp>
+#include <rcb4/robot/services/project.hpp>
+#include <rcb4/robot/services/trims.hpp>
+
+#include <filesystem>
+
+namespace cli {
+namespace {
+
+namespace sv = rcb4::robot::services;
+namespace h4 = rcb4::robot::hth4;
+
+h4::project load(const std::string& file) {
+  try {
+    return h4::load_project(file);
+  } catch (const rcb4::robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+}
+
+struct import_options {
+  motion_options m;
+  std::string file;
+  bool dry_run = false, project_baud = false;
+};
+
+int import(session& s, const import_options& o, const globals& g) {
+  const auto p = load(o.file);
+  const auto& layout = layout_for(s, o.m);
+  const auto version = s.run(rcb4::ops::read_version{});
+  session_link link(s, g.json);
+  const auto save_before = [&](std::span<const std::uint8_t> now) {
+    const std::string before = fmt::format("rom-before-import-{}.bin", file_stamp());
+    sv::save_rom_image(before, now, version);
+    return before;
+  };
+  const auto r = sv::import_project(link, layout, robot_of(g), p, {o.dry_run, !o.project_baud}, save_before);
+  const auto changing =
+      std::count_if(r.plan.areas.begin(), r.plan.areas.end(), [](const auto& a) { return a.changes; });
+  if (g.json) {
+    json areas = json::array();
+    for (const auto& a : r.plan.areas)
+      areas.push_back({{"what", a.what}, {"address", a.address}, {"bytes", a.size}, {"changes", a.changes}});
+    emit(json{{"project", o.file},
+              {"dry_run", o.dry_run},
+              {"layout", layout.name},
+              {"relocated", r.relocated},
+              {"areas", areas},
+              {"changes", changing},
+              {"not_written", r.plan.not_written},
+              {"backup", r.written.before.empty() ? json(nullptr) : json(r.written.before)},
+              {"pieces_written", r.written.pieces},
+              {"ram_trims", r.ram_trims},
+              {"period_set", r.period_set}});
+    return exit_ok;
+  }
+  fmt::print("{} ({} layout{}) {} the board ({}):\n", o.file, p.layout().name,
+             r.relocated ? fmt::format(", moved to the board's {}", layout.name) : std::string(),
+             o.dry_run ? "would write to" : "written to",
+             o.dry_run ? "dry run: nothing written" : "each piece read back");
+  for (const auto& a : r.plan.areas)
+    fmt::print("  {} 0x{:06X}  {}\n", a.changes ? (o.dry_run ? "change" : "wrote ") : "same  ", a.address, a.what);
+  for (const auto& n : r.plan.not_written) fmt::print("  not written: {}\n", n);
+  if (o.dry_run)
+    fmt::print("{} of {} areas would change; run it again without --dry-run to write them\n", changing,
+               r.plan.areas.size());
+  else if (r.written.unchanged)
+    fmt::print("the board already held all of it: nothing written\n");
+  else
+    fmt::print(
+        "{} areas changed ({} of ROM written); the ROM it replaced is in {}\n"
+        "trims also in RAM for {} servos; {} slot names set; the rest acts after the board is powered off and on\n",
+        changing, plural(r.written.pieces, "piece"), r.written.before, r.ram_trims, r.names);
+  if (r.period_set)
+    fmt::print("the board's output period is now {} ms, the project's (its motions were made for it)\n",
+               rcb4::milliseconds(rcb4::config_word::decode(p.config).period));
+  if (r.written.program_stopped)
+    fmt::print(
+        "the ROM program was stopped for the write: `rcb4 motion resume` runs it again (buttons play nothing until "
+        "then)\n");
+  return exit_ok;
+}
+
+int export_to(session& s, const motion_options& m, const std::string& file, bool force, const globals& g) {
+  if (std::filesystem::exists(file) && !force)
+    throw usage_error(fmt::format("FILE: {} exists (--force replaces it)", file));
+  const auto& layout = layout_for(s, m);
+  session_link link(s, g.json);
+  auto e = sv::export_project(link, layout, robot_of(g));
+  e.value.file_name = std::filesystem::absolute(file).string();
+  e.value.path = std::filesystem::absolute(file).parent_path().string();
+  e.value.name = std::filesystem::path(file).stem().string();
+  try {
+    h4::save_project(file, e.value);
+  } catch (const rcb4::robot::profile_error& x) {
+    throw usage_error(x.what());
+  }
+  const auto used =
+      std::count_if(e.value.motions.begin(), e.value.motions.end(), [](const auto& x) { return !x.frames.empty(); });
+  if (g.json) {
+    emit(json{{"file", file}, {"layout", layout.name}, {"motions", used}, {"left_out", e.left_out}});
+    return exit_ok;
+  }
+  fmt::print("the board ({} layout) -> {}: {}, config 0x{:04X}, {} allocated servos\n", layout.name, file,
+             plural(static_cast<std::size_t>(used), "motion"), e.value.config,
+             std::count_if(e.value.servos.begin(), e.value.servos.end(),
+                           [](const auto& x) { return x.mode == h4::servo_mode::normal; }));
+  for (const auto& l : e.left_out) fmt::print("  left out: {}\n", l);
+  return exit_ok;
+}
+
+int trim_import(session& s, const std::string& file, bool persist, const globals& g) {
+  std::vector<h4::trim_entry> entries;
+  try {
+    entries = h4::load_trim_file(file);
+  } catch (const rcb4::robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  std::vector<std::pair<unsigned, std::int16_t>> trims;
+  for (const auto& t : entries) trims.push_back({t.device_number, static_cast<std::int16_t>(t.trim)});
+  session_link link(s, g.json);
+  const auto r = sv::set_ics_trims(link, trims, persist);
+  const auto name_of = [&](unsigned ics) {
+    for (const auto& t : entries)
+      if (t.device_number == ics) return t.name;
+    return std::string();
+  };
+  if (g.json) {
+    json written = json::array(), skipped = json::array();
+    for (const auto& [ics, c] : r.written) written.push_back({{"ics", ics}, {"name", name_of(ics)}, {"counts", c}});
+    for (const auto& [ics, c] : r.skipped) skipped.push_back({{"ics", ics}, {"name", name_of(ics)}, {"counts", c}});
+    emit(json{{"file", file}, {"persistent", persist}, {"written", written}, {"skipped", skipped}});
+    return exit_ok;
+  }
+  for (const auto& [ics, c] : r.written) fmt::print("  ICS {:>2} {:<22} {:+6d} counts\n", ics, name_of(ics), c);
+  std::vector<std::string> skipped;
+  for (const auto& [ics, c] : r.skipped)
+    if (c != 0) skipped.push_back(fmt::format("ICS {} ({:+d})", ics, c));
+  fmt::print("{} trims written to RAM{}, each read back{}\n", r.written.size(), persist ? " and ROM" : "",
+             persist ? "" : " (they last until power-off: --persist keeps them)");
+  if (!skipped.empty()) fmt::print("not written, the board has no servo allocated for: {}\n", fmt::join(skipped, ", "));
+  return exit_ok;
+}
+
+}  // namespace
+
+void add_project_commands(CLI::App& app, context& ctx) {
+  auto* project = app.add_subcommand("project", "HeartToHeart4 projects (.h4p): onto the board and back");
+  project->require_subcommand(1);
+  auto io = std::make_shared<import_options>();
+  auto* imp = project->add_subcommand(
+      "import",
+      "put FILE.h4p on the board as HTH4's \"write to robot\" does, as far as its bytes are known: motions, "
+      "buttons, servos and trims, config word, AD references, start-up motion; the ROM saved first "
+      "(rom-before-import-DATE.bin), only what differs written, each piece read back");
+  imp->add_option("FILE", io->file, "an HTH4 project (.h4p, HTH4 2.x)")->required();
+  imp->add_flag("--dry-run", io->dry_run, "list every area and whether it would change; write nothing");
+  imp->add_flag("--project-baud", io->project_baud,
+                "take the COM baud from the project's config word too (default: keep the board's, so the link "
+                "survives a power cycle)");
+  add_layout(imp, io->m);
+  on_device(imp, ctx, [&ctx, io](session& s) { return import(s, *io, ctx.g); });
+
+  struct export_options {
+    motion_options m;
+    std::string file;
+    bool force = false;
+  };
+  auto eo = std::make_shared<export_options>();
+  auto* exp = project->add_subcommand(
+      "export",
+      "write the board as an HTH4 project FILE.h4p: config, servos (named by --robot's joints), every used "
+      "slot's code and name, the buttons, the start-up motion");
+  exp->add_option("FILE", eo->file, "the project to write")->required();
+  exp->add_flag("--force", eo->force, "replace FILE when it exists");
+  add_layout(exp, eo->m);
+  on_device(exp, ctx, [&ctx, eo](session& s) { return export_to(s, eo->m, eo->file, eo->force, ctx.g); });
+}
+
+void add_trim_import(CLI::App* trim, context& ctx) {
+  struct options {
+    std::string file;
+    bool persist = false;
+  };
+  auto o = std::make_shared<options>();
+  auto* imp = trim->add_subcommand(
+      "import", "write an HTH4 trim file's trims (FILE.h4t) by ICS number to the servos the board allocates");
+  imp->add_option("FILE", o->file, "an HTH4 trim file (.h4t)")->required();
+  imp->add_flag("--persist", o->persist, "also into ROM's servo image, so power-on loads them (as trim set --persist)");
+  on_device(imp, ctx, [&ctx, o](session& s) { return trim_import(s, o->file, o->persist, ctx.g); });
+}
+
+}  // namespace cli
