@@ -11,6 +11,7 @@ import json
 import os
 import sys
 import tempfile
+import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import check, finish, tool
@@ -139,5 +140,36 @@ with serve() as dev:
     check(t.get("counts") == -3960 and t.get("rom_counts") == -3960, f"trim get after trim import ({out!r})")
     rc, out, err = run(*on, "trim", "import", PROJECT)
     check(rc == 2 and "not <ArrayOfDictionaryEntry>" in err, f"a project is not a trim file: exit 2 ({err.strip()!r})")
+
+    # Power-on: the start-up motion (HTH4's CALL at 0x0444) and the boot config word.
+    # (The import wrote the project's StartupMotionAddress, 2944: motion 1.)
+    rc, out, err = run(*on, "motion", "startup")
+    check(rc == 0 and 'motion 1 "wave_twice" (0x000B80) plays at power-on' in out, f"motion startup: the project's ({out!r})")
+    rc, out, err = run(*on, "motion", "startup", "none")
+    check(rc == 0 and "no start-up motion" in out and rom(on, 0x0444, 7) == bytes.fromhex("070C80CB030061"),
+          f"motion startup none: DefaultStartup, 07 0C 80 CB 03 00 61 ({out!r})")
+    rc, out, err = run(*on, "motion", "startup", "30")
+    check(rc == 1 and "holds no motion" in err and rom(on, 0x0444, 7) == bytes.fromhex("070C80CB030061"),
+          f"motion startup 30 (empty): exit 1, nothing written ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "startup", "3")
+    check(rc == 0 and "motion 3" in out and rom(on, 0x0444, 7) == bytes.fromhex("070C801B0000AE"),
+          f"motion startup 3: the CALL at 0x0444 (07 0C 80 1B 00 00 AE) ({rc}: {out!r} {err!r})")
+    run(*on, "motion", "stop")
+    boot_before = rom(on, 0x05DC, 2)
+    rc, out, err = run(*on, "config", "set", "led=on", "--persist")
+    boot_after = rom(on, 0x05DC, 2)
+    check(rc == 0 and boot_after[1] == boot_before[1] | 0x80 and boot_after[0] == boot_before[0],
+          f"config set led=on --persist: only the LED bit added to ROM's word, the stopped program not kept "
+          f"({rc}: {boot_before.hex()} -> {boot_after.hex()} {err!r})")
+    backup(on, "startup.bin")
+
+# The board powered on from that ROM plays motion 3 by itself (a call of motion 2: ICS 2 to 7000).
+with serve("--rom", "startup.bin") as dev:
+    seen, t0 = [], time.monotonic()
+    while time.monotonic() - t0 < 5 and not (seen and min(seen) <= 7200):
+        rc, out, err = run("--json", "--device", dev, "servo", "get", "2")
+        if rc == 0:
+            seen.append(json.loads(out)[0]["position"])
+    check(seen and min(seen) <= 7200, f"at power-on the start-up motion plays (ICS 2 on its way to 7000: {seen[-5:]})")
 
 finish()

@@ -42,8 +42,14 @@ TEST_CASE("board: power-on RAM is an HTH4 2.2 boot", "[board]") {
   }
   CHECK(w.read_word(0x0090 + 4) == 7500);  // ICS 0 current position
   CHECK(w.read_word(0x008C) == 0x0357);    // vector table
+  // The program starts at StartupCmd (hth4-files.md §3): a CALL of DefaultStartup, a RETURN, then
+  // the main loop.
   const auto pc = w.read_ram(0x0002, 3);
-  CHECK((pc[0] | (pc[1] << 8) | (pc[2] << 16)) == 0x00044B);
+  CHECK((pc[0] | (pc[1] << 8) | (pc[2] << 16)) == 0x000444);
+  w.wait(std::chrono::milliseconds(50));
+  const auto later = w.read_ram(0x0002, 3);
+  CHECK((later[0] | (later[1] << 8) | (later[2] << 16)) == 0x00044B);
+  CHECK(w.read_ram(0x0005, 1)[0] == 0);  // nothing left on the stack
 }
 
 TEST_CASE("board: MOV between RAM, ICS, ROM and COM", "[board][mov]") {

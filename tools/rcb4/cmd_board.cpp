@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/robot/services/boot.hpp>
+
 #include <algorithm>
 
 namespace cli {
@@ -162,7 +164,7 @@ struct config_changes {
   }
 };
 
-int config_set(session& s, const config_changes& ch, const globals& g) {
+int config_set(session& s, const config_changes& ch, bool persist, const globals& g) {
   if (!ch.fields.empty()) s.run(rcb4::ops::update_config([&](rcb4::config_word& c) { ch.apply(c); }));
   if (ch.baud) {
     if (!s.rate_known())
@@ -170,9 +172,22 @@ int config_set(session& s, const config_changes& ch, const globals& g) {
                     "the board would switch, but the bridge's serial side would not follow: set the bridge's rate "
                     "yourself, or change the baud on a serial port");
     rcb4::transport::switch_baud(s.c(), *ch.baud);  // the board, then this port, then a ping
-    if (!g.json) fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *ch.baud);
+    if (!g.json && !persist)
+      fmt::print("the board now speaks {} baud (until power-off: the ROM keeps the old rate)\n", *ch.baud);
   }
-  print_config(s.run(rcb4::ops::read_config{}), g);
+  const auto now = s.run(rcb4::ops::read_config{});
+  if (persist) {
+    // The changes, made to the word power-on loads (not RAM's whole word: a program stopped now
+    // must not stay stopped at every power-on).
+    session_link link(s, g.json);
+    auto boot = rcb4::robot::services::boot_config(link);
+    ch.apply(boot);
+    if (ch.baud) boot.com_baud = now.com_baud;
+    rcb4::robot::services::persist_config(link, boot);
+    if (!g.json)
+      fmt::print("kept in ROM (0x0005DC): the board starts with config word 0x{:04X} after power-on\n", boot.encode());
+  }
+  print_config(now, g);
   return exit_ok;
 }
 
@@ -203,18 +218,22 @@ void add_board_commands(CLI::App& app, context& ctx) {
     print_config(s.run(rcb4::ops::read_config{}), ctx.g);
     return exit_ok;
   });
-  auto* set = config->add_subcommand("set", "change fields of the config register (RAM only: power-off restores)");
+  auto* set = config->add_subcommand(
+      "set", "change fields of the config register (RAM only unless --persist: power-off restores)");
+  auto persist = std::make_shared<bool>(false);
+  set->add_flag("--persist", *persist,
+                "also write the resulting word to ROM (0x0005DC), the config the board loads at power-on");
   auto pairs = std::make_shared<std::vector<std::string>>();
   set->add_option("KEY=VALUE", *pairs,
                   "ics, program, vector-jump, interp-message, led = on|off; period = 10|15|20|25 (ms); "
                   "ics-baud = 115200|625000|1250000; baud = 115200|625000|1250000 (switches the board, then "
                   "this port follows)")
       ->required();
-  set->callback([&ctx, pairs] {
+  set->callback([&ctx, pairs, persist] {
     auto ch = std::make_shared<config_changes>(*pairs);  // usage errors before the device opens
-    ctx.action = [&ctx, ch] {
+    ctx.action = [&ctx, ch, persist] {
       session s(ctx.g);
-      return config_set(s, *ch, ctx.g);
+      return config_set(s, *ch, *persist, ctx.g);
     };
   });
 }

@@ -437,6 +437,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   add_motion_file_commands(motion, ctx);
   add_record_command(motion, ctx);
   add_button_commands(motion, ctx);
+  add_startup_command(motion, ctx);
 }
 
 }  // namespace cli

@@ -2,7 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 //
 // Layout (protocol.md §8, HTH4 2.2+):
-//   0x000000  boot: MOV ROM 0x0005DC → RAM 0x0000 (config word), then JUMP 0x00044B
+//   0x000000  boot: MOV ROM 0x0005DC → RAM 0x0000 (config word), then JUMP 0x000444
+//   0x000444  StartupCmd: CALL 0x03CB80 (DefaultStartup, a RETURN: no start-up motion)
 //   0x00044B  main loop: OR 0x08 into the config word (the vector switch on again, as HTH4's
 //             main loop sets it: motions.md §4), JUMP 0x00044B; motions are CALLed
 //   0x0005DC  ConfigDataRom: the config word loaded at power-on
@@ -72,7 +73,12 @@ inline std::vector<std::uint8_t> default_rom() {
   const auto& l = hth4_2_2;
   std::uint32_t at = 0;
   at = put_frame(rom, at, encode(move::make(destination::ram(ram::config), source::rom(l.config, 2).value()).value()));
-  put_frame(rom, at, encode(jump{l.main_loop}));
+  put_frame(rom, at, encode(jump{l.startup}));
+  // StartupCmd: CALL DefaultStartup, a RETURN after the last slot (DOC-PRG; hth4-files.md §3), as
+  // HTH4 2.2 writes a board with no start-up motion; `rcb4 motion startup N` changes it.
+  const auto default_startup = l.motion_base.value() + l.motion_count * l.slot_size;
+  put_frame(rom, l.startup.value(), encode(call{rom_address::make(default_startup).value()}));
+  put_frame(rom, default_startup, encode(ret{}));
   static constexpr std::uint8_t vector_bit[] = {0x08};  // config bit 3 (a literal is referenced, not copied)
   const auto vector_on = logic::make(logic_op::or_, destination::ram(ram::config), source::literal(vector_bit).value());
   put_frame(rom, put_frame(rom, l.main_loop.value(), encode(vector_on.value())), encode(jump{l.main_loop}));
