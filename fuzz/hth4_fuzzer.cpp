@@ -3,8 +3,11 @@
 //   - the only way out is a value or a profile_error whose text starts with the source name;
 //   - an accepted project passes check_project again, is written and reads back to the same
 //     value, and its motions relocate to the other layout and back unchanged;
-//   - an accepted trim file is written and reads back to the same entries.
+//   - an accepted trim file is written and reads back to the same entries;
+//   - an accepted flowchart compiles or is refused with a profile_error; compiled, its frames
+//     all pass their SIZE and SUM, fit the slot and end in 03 0D 10 FF.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/robot/hth4/flowchart.hpp>
 #include <rcb4/robot/hth4/project.hpp>
 #include <rcb4/robot/hth4/trim_file.hpp>
 
@@ -43,6 +46,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     CHECK(hth4::parse_trim_file(hth4::trim_file_xml(t), "back.h4t") == t);
   } catch (const profile_error& e) {
     CHECK(std::string_view(e.what()).substr(0, 8) == "fuzz.h4t");
+  } catch (const std::exception& e) {
+    check(false, e.what(), __LINE__);
+  }
+  try {
+    const auto f = hth4::parse_flowchart(text, "fuzz.xml");
+    const auto c = hth4::compile_flowchart(f, 0x0B80, rcb4::hth4_2_2, "fuzz.xml");
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < c.frames.size(); ++i) {
+      const auto& fr = c.frames[i];
+      n += fr.size();
+      if (i + 1 < c.frames.size()) CHECK(fr.size() >= 3 && fr[0] == fr.size() && rcb4::checksum_ok(fr));
+    }
+    CHECK(!c.frames.empty() && c.frames.back() == std::vector<std::uint8_t>({0x03, 0x0D, 0x10, 0xFF}));
+    CHECK(n <= 2048);
+  } catch (const profile_error& e) {
+    CHECK(std::string_view(e.what()).substr(0, 8) == "fuzz.xml");
   } catch (const std::exception& e) {
     check(false, e.what(), __LINE__);
   }

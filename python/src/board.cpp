@@ -159,6 +159,7 @@ void board::fail(const std::error_code& ec, const std::string& what) {
         std::uint32_t got = 0;
         bool parity = false;
         const auto again = t::detail::set_rcb4_line(line_fd_, line_baud_, got, parity);
+        ::tcflush(line_fd_, TCIOFLUSH);  // what the cooked line echoed or kept is no reply
         const std::string changed = "another program changed " + where_ + "'s settings (" +
                                     (rate ? std::string() : "rate " + std::to_string(now.c_ospeed) + " baud") +
                                     (!rate && !raw ? ", " : "") + (raw ? "" : "no longer a raw 8-bit line") + ")";

@@ -161,7 +161,15 @@ def test_terminal_settings_changed_by_another_program(served):
             b.ping()
         if isinstance(e.value, pyrcb4.DeviceError):
             assert "another program changed" in str(e.value) and "set again" in str(e.value), str(e.value)
-        assert b.ping() < 1  # set again: it answers
+        # Set again: it answers. (The cooked line echoed the board's replies back into the board,
+        # whose parser then resyncs: under a loaded machine one more call may still time out.)
+        for attempt in range(3):
+            try:
+                assert b.ping() < 1
+                break
+            except pyrcb4.Timeout:
+                if attempt == 2:
+                    raise
 
 
 def test_slot_names_kept_with_the_code(board):

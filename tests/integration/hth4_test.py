@@ -141,6 +141,30 @@ with serve() as dev:
     rc, out, err = run(*on, "trim", "import", PROJECT)
     check(rc == 2 and "not <ArrayOfDictionaryEntry>" in err, f"a project is not a trim file: exit 2 ({err.strip()!r})")
 
+    # Flowcharts (.xml): into a motion file (either schema, the same steps), or compiled into a slot.
+    for name in ("wave_twice.xml", "wave_twice_old.xml"):
+        rc, out, err = run("motion", "import", os.path.join(DATA, name), name + ".yaml", "--period", "15")
+        with open(name + ".yaml") as f:
+            y = f.read() if rc == 0 else ""
+        check(rc == 0 and "set_counter: 2" in y and "count_down:" in y and "period_ms: 15" in y,
+              f"motion import {name}: a motion file ({rc}: {err.strip()!r} {y[:200]!r})")
+    rc, out, err = run(*on, "motion", "push", "wave_twice.xml.yaml", "20", "--backup", "twenty.bin")
+    rc2, out2, err2 = run(*on, "motion", "import", os.path.join(DATA, "wave_twice.xml"), "--push", "21", "--backup", "t1.bin")
+    # The same motion at slots 20 and 21: the same bytes but for the jump targets (slot 20 vs 21).
+    a, b = rom(on, 0x0B80 + 19 * 2048, 59), rom(on, 0x0B80 + 20 * 2048, 59)
+    def offsets(code, base):  # the two JUMPs' targets (at 29 and 36) from the slot's start
+        return [int.from_bytes(code[j + 2:j + 5], "little") - base for j in (29, 36)] if len(code) == 59 else []
+    check(rc == 0 and rc2 == 0 and a[:29] == b[:29] and a[43:] == b[43:] and b[-3:] == bytes([3, 13, 16])
+          and offsets(a, 0x0B80 + 19 * 2048) == offsets(b, 0x0B80 + 20 * 2048) == [0x2B, 0x08],
+          f"the imported file pushes to the bytes --push writes ({rc}, {rc2}: {err.strip()!r} {err2.strip()!r})")
+    rc, out, err = run("motion", "import", os.path.join(DATA, "wait_and_call.xml"), "w.yaml")
+    check(rc == 2 and "cannot express it" in err and "--push N" in err, f"a Wait block: no motion file, says --push ({err.strip()!r})")
+    rc, out, err = run(*on, "motion", "import", os.path.join(DATA, "wait_and_call.xml"), "--push", "22", "--backup", "t2.bin")
+    check(rc == 0 and "moved to 0x001380" in err and rom(on, 0x0B80 + 21 * 2048 + 0x26, 7) == bytes.fromhex("070C80130000A6"),
+          f"motion import --push: compiled into slot 22, its call moved to this layout ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "play", "22", "--wait", "--timeout", "10")
+    check(rc == 0 and "done after" in out, f"the imported motion plays (a Wait of 0.8 s, a call) ({rc}: {out!r} {err!r})")
+
     # Power-on: the start-up motion (HTH4's CALL at 0x0444) and the boot config word.
     # (The import wrote the project's StartupMotionAddress, 2944: motion 1.)
     rc, out, err = run(*on, "motion", "startup")

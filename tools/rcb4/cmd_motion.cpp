@@ -438,6 +438,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   add_record_command(motion, ctx);
   add_button_commands(motion, ctx);
   add_startup_command(motion, ctx);
+  add_flowchart_import(motion, ctx);
 }
 
 }  // namespace cli

@@ -5,14 +5,19 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include <rcb4/motion/disassemble.hpp>
+#include <rcb4/robot/hth4/flowchart.hpp>
 #include <rcb4/robot/hth4/project.hpp>
 #include <rcb4/robot/hth4/trim_file.hpp>
+#include <rcb4/robot/motion_file.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/project.hpp>
 #include <rcb4/robot/services/trims.hpp>
 
 #include <filesystem>
 
 namespace cli {
+namespace ro = rcb4::robot;
 namespace {
 
 namespace sv = rcb4::robot::services;
@@ -150,7 +155,124 @@ int trim_import(session& s, const std::string& file, bool persist, const globals
   return exit_ok;
 }
 
+struct flow_options {
+  motion_options m;
+  std::string file, out, backup;
+  long long slot = 1, push = 0, period_ms = 10;
+  bool force = false;
+};
+
+/** FILE.xml compiled into slot @p n of @p layout, as bytes (and what was adjusted). */
+std::pair<std::vector<std::uint8_t>, std::vector<std::string>> compile(const std::string& file,
+                                                                       const rcb4::rom_layout& layout, unsigned n) {
+  try {
+    const auto c =
+        h4::compile_flowchart(h4::load_flowchart(file), sv::slot_for(layout, n).address.value(), layout, file);
+    std::vector<std::uint8_t> bytes;
+    for (const auto& f : c.frames) bytes.insert(bytes.end(), f.begin(), f.end());
+    return {bytes, c.notes};
+  } catch (const rcb4::robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+}
+
+/** motion import FILE.xml OUT.yaml: the flowchart as a motion file (no board needed). */
+int flow_to_file(const flow_options& o, const globals& g) {
+  if (o.out.empty()) throw usage_error("OUT: give the motion file to write, or --push N to write the slot");
+  if (std::filesystem::exists(o.out) && !o.force)
+    throw usage_error(fmt::format("OUT: {} exists (--force replaces it)", o.out));
+  if (o.period_ms < 10 || o.period_ms > 25 || o.period_ms % 5)
+    throw usage_error(fmt::format("--period: {} ms is not one of 10, 15, 20 or 25", o.period_ms));
+  const auto* named = named_layout(o.m);
+  const auto& layout = named ? *named : rcb4::hth4_2_2;
+  const auto n = static_cast<unsigned>(o.slot);
+  const auto [bytes, notes] = compile(o.file, layout, n);
+  const auto where = sv::slot_for(layout, n);
+  const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where));
+  if (!rcb4::motion::ok(p))
+    throw failure(exit_usage,
+                  fmt::format("{}: compiled, but a motion file cannot express it: {}", o.file,
+                              std::get<rcb4::motion::failure>(p).message),
+                  fmt::format("write it to the board as compiled: rcb4 motion import {} --push N", o.file));
+  auto d = ro::from_program(std::get<rcb4::motion::program>(p), robot_of(g), layout,
+                            static_cast<rcb4::output_period>((o.period_ms - 10) / 5));
+  d.name = std::filesystem::path(o.file).stem().string();
+  try {
+    ro::save_motion(o.out, d,
+                    fmt::format("imported by rcb4 from the HTH4 flowchart {} (compiled for slot {}, {} layout)", o.file,
+                                n, layout.name));
+  } catch (const ro::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  if (g.json) {
+    emit(json{{"file", o.file}, {"out", o.out}, {"steps", d.steps.size()}, {"bytes", bytes.size()}, {"notes", notes}});
+    return exit_ok;
+  }
+  for (const auto& note : notes) fmt::print(stderr, "note: {}\n", note);
+  fmt::print("{} -> {}: {} steps ({} bytes compiled, {} ms frames)\n", o.file, o.out, d.steps.size(), bytes.size(),
+             o.period_ms);
+  return exit_ok;
+}
+
+/** motion import FILE.xml --push N: compiled into slot N as HTH4 would, through the push service. */
+int flow_push(session& s, const flow_options& o, const globals& g) {
+  const auto& layout = layout_for(s, o.m);
+  const auto n = static_cast<unsigned>(o.push);
+  sv::slot_for(layout, n);
+  const auto [bytes, notes] = compile(o.file, layout, n);
+  session_link link(s, g.json);
+  sv::push_source src;
+  src.bin = bytes;
+  src.name = o.file;
+  const auto r = sv::push_motion(
+      link, robot_of(g), layout, n, src,
+      [&](unsigned motion, std::span<const std::uint8_t> old) { return sv::save_backup_file(motion, old, o.backup); });
+  if (g.json) {
+    emit(json{{"file", o.file},
+              {"pushed", n},
+              {"bytes", bytes.size()},
+              {"unchanged", r.unchanged},
+              {"backup", r.backup},
+              {"notes", notes}});
+    return exit_ok;
+  }
+  for (const auto& note : notes) fmt::print(stderr, "note: {}\n", note);
+  if (r.unchanged)
+    fmt::print("motion {} already holds {} as compiled: nothing written\n", n, o.file);
+  else
+    fmt::print("{} compiled ({} bytes) -> motion {} (0x{:06X}), read back; the old bytes are in {}\n", o.file,
+               bytes.size(), n, r.address, r.backup);
+  return exit_ok;
+}
+
 }  // namespace
+
+void add_flowchart_import(CLI::App* motion, context& ctx) {
+  auto o = std::make_shared<flow_options>();
+  auto* imp = motion->add_subcommand(
+      "import",
+      "an HTH4 motion flowchart (FILE.xml, either schema) compiled as HTH4 does: into a motion file OUT, "
+      "or with --push N into slot N of the board");
+  imp->add_option("FILE", o->file, "an HTH4 flowchart (.xml)")->required();
+  imp->add_option("OUT", o->out, "the motion file to write (YAML)");
+  imp->add_option("--slot", o->slot, "the slot it is compiled for (its jumps are absolute; default 1)")
+      ->check(CLI::Range(1, 120));
+  imp->add_option("--period", o->period_ms, "the output period its frames were made for, in ms (default 10)");
+  imp->add_option("--push", o->push, "write it compiled into slot N of the board (backup first, read back)")
+      ->check(CLI::Range(1, 120));
+  imp->add_option("--backup", o->backup, "with --push: where the slot's old bytes go (default motion-N-DATE.bin)");
+  imp->add_flag("--force", o->force, "replace OUT when it exists");
+  add_layout(imp, o->m);
+  imp->callback([&ctx, o] {
+    if (o->push)
+      ctx.action = [&ctx, o] {
+        session s(ctx.g);
+        return flow_push(s, *o, ctx.g);
+      };
+    else
+      ctx.action = [&ctx, o] { return flow_to_file(*o, ctx.g); };
+  });
+}
 
 void add_project_commands(CLI::App& app, context& ctx) {
   auto* project = app.add_subcommand("project", "HeartToHeart4 projects (.h4p): onto the board and back");

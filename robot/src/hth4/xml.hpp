@@ -8,6 +8,7 @@
 
 #include <pugixml.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <fstream>
@@ -53,6 +54,13 @@ class xml_in {
     std::size_t line = 1;
     for (std::size_t i = 0; i < offset; ++i) line += text_[i] == '\n';
     return source_ + ":" + std::to_string(line);
+  }
+  /** The line of @p n (1-based; 0 when unknown). */
+  unsigned line_of(const pugi::xml_node& n) const {
+    const auto off = n.offset_debug();
+    if (off < 0) return 0;
+    const auto end = std::min(static_cast<std::size_t>(off), text_.size());
+    return static_cast<unsigned>(std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n') + 1);
   }
   /** "FILE:LINE: <Element>" of @p n. */
   std::string where(const pugi::xml_node& n) const {

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Writes the HTH4 test files of this folder, in HeartToHeart4's schema (hth4-files.md §2, §6), by
 hand and independently of rcb4's writer: the project three_motions.h4p (HTH4 2.2+ layout), the same
-project in the 2.0-2.1 layout (three_motions_2_0.h4p) and a trim file (trims.h4t). The values are
+project in the 2.0-2.1 layout (three_motions_2_0.h4p), a trim file (trims.h4t) and flowcharts
+(wave_twice.xml in the new schema and wave_twice_old.xml in the old, §5.7; wait_and_call.xml). The values are
 made up; the frames of motion 1 are the ones hth4-files.md §2.6 prints. Run it to regenerate:
     tests/data/hth4/make_fixtures.py
 SPDX-License-Identifier: BSL-1.0"""
@@ -155,7 +156,94 @@ def trims():
     return "\r\n".join(L).replace("\r\n", "\n").replace("\n", "\r\n")
 
 
+def guid(kind, n):
+    return f"{kind}0000000-0000-4000-8000-{n:012d}"
+
+
+def flowchart_new(blocks, lines):
+    """A new-schema flowchart (hth4-files.md §5.1, §5.7): blocks (name, base, start, frames, [(line, Begin|End)]),
+    lines (n, mode)."""
+    L = ['<?xml version="1.0"?>', f'<CanvasData {XSI}>', "  <Name>canvas</Name>",
+         "  <Size>", "    <Width>640</Width>", "    <Height>480</Height>", "  </Size>", "  <GridSize>8</GridSize>", "  <Lines>"]
+    for n, mode in lines:
+        L += ['    <anyType xsi:type="LineData">', f"      <GUID>{guid('a', n)}</GUID>", "      <Path>",
+              "        <Point>", "          <X>40</X>", "          <Y>64</Y>", "        </Point>", "      </Path>",
+              f"      <ConnectMode>{mode}</ConnectMode>", "    </anyType>"]
+    L += ["  </Lines>", "  <Activities>"]
+    for i, (name, base, start, frames, conns) in enumerate(blocks):
+        L += ['    <anyType xsi:type="ActivityData">', f"      <Name>{name}</Name>", f"      <GUID>{guid('b', i + 1)}</GUID>",
+              "      <Location>", f"        <X>8</X>", f"        <Y>{16 + 80 * i}</Y>", "      </Location>",
+              "      <Size>", "        <Width>64</Width>", "        <Height>48</Height>", "      </Size>",
+              f"      <Text>{name}</Text>", "      <BackColorText>WhiteSmoke</BackColorText>",
+              f"      <MotionFlag>{'Start' if start else 'None'}</MotionFlag>", f"      <BaseName>{base}</BaseName>",
+              f"      <Description>{base}</Description>", "      <Group>Set</Group>",
+              f"      <ConnectedGuids>{','.join(guid('a', n) for n, _ in conns)}</ConnectedGuids>",
+              f"      <ConnectTypes>{','.join(t + 'Connect' for _, t in conns)}</ConnectTypes>", "      <ProgramCode>"]
+        L += [f'        <anyType xsi:type="xsd:string">{text(f)}</anyType>' for f in frames]
+        L += ["      </ProgramCode>", f"      <Hint>{base}</Hint>", "    </anyType>"]
+    L += ["  </Activities>", "  <BackColorText>buttonface</BackColorText>", "</CanvasData>"]
+    return "\r\n".join(L)
+
+
+def flowchart_old(blocks, lines):
+    """The old schema (§5.1, §5.3): activities and lines mixed, four connection slots (top, bottom, left,
+    right) per block, PriorityList labelling them (04 True, 01 False)."""
+    zero = "00000000-0000-0000-0000-000000000000"
+    L = ['<?xml version="1.0"?>', f'<ArrayOfAnyType {XSI}>']
+    for i, (name, base, start, frames, slots) in enumerate(blocks):
+        L += ['  <anyType xsi:type="ActivityData">', f"    <Name>{name}</Name>", f"    <GUID>{guid('b', i + 1)}</GUID>",
+              "    <Location>", "      <X>8</X>", f"      <Y>{16 + 80 * i}</Y>", "    </Location>", "    <Size>",
+              "      <Width>64</Width>", "      <Height>48</Height>", "    </Size>",
+              f"    <MotionFlag>{'Start' if start else 'None'}</MotionFlag>", "    <PriorityList>",
+              f'      <anyType xsi:type="xsd:string">{" ".join(f"{lab:02X}" for _, _, lab in slots)}</anyType>',
+              "    </PriorityList>", f"    <BaseName>{base}</BaseName>", f"    <Description>{base}</Description>",
+              "    <Group>Set</Group>", "    <Path />",
+              f"    <ConnectedGuids>{','.join(guid('a', n) if n else zero for n, _, _ in slots)}</ConnectedGuids>",
+              f"    <ConnectTypes>{','.join(t + 'Connect' if n else 'NotConnected' for n, t, _ in slots)}</ConnectTypes>",
+              "    <ProgramCode>"]
+        L += [f'      <anyType xsi:type="xsd:string">{text(f)}</anyType>' for f in frames]
+        L += ["    </ProgramCode>", "  </anyType>"]
+    for n in lines:
+        L += ['  <anyType xsi:type="LineData">', "    <Name />", "    <StartPoint>", "      <X>40</X>", "      <Y>64</Y>",
+              "    </StartPoint>", "    <EndPoint>", "      <X>40</X>", "      <Y>96</Y>", "    </EndPoint>",
+              f"    <GUID>{guid('a', n)}</GUID>", "    <LineType>Straight</LineType>", "  </anyType>"]
+    L.append("</ArrayOfAnyType>")
+    return "\r\n".join(L)
+
+
+# hth4-files.md §5.7: SetCounter1 (Start) -> Pos2 -> Loop3; Loop3 False -> Pos2, True -> Pos4. The
+# loop's JUMP waits for its target (FF FF FF, its SUM over the placeholder: 14).
+SET_COUNTER = [0x08, 0x00, 0x02, 0x57, 0x04, 0x00, 0x02, 0x67]
+POS2 = [0x0D, 0x10, 0x0C, 0x00, 0x00, 0x00, 0x00, 0x14, 0x78, 0x1E, 0x20, 0x1C, 0x0F]
+LOOP = [[0x08, 0x07, 0x02, 0x57, 0x04, 0x00, 0x01, 0x6D], [0x07, 0x0B, 0xFF, 0xFF, 0xFF, 0x05, 0x14]]
+POS4 = [0x0D, 0x10, 0x0C, 0x00, 0x00, 0x00, 0x00, 0x1E, 0x4C, 0x1D, 0x4C, 0x1D, 0x19]
+WAVE_NEW = flowchart_new(
+    [("SetCounter1", "SetCounter", True, [SET_COUNTER], [(1, "Begin")]),
+     ("Pos2", "Pos", False, [POS2], [(1, "End"), (2, "Begin"), (3, "End")]),
+     ("Loop3", "Loop", False, LOOP, [(2, "End"), (3, "Begin"), (4, "Begin")]),
+     ("Pos4", "Pos", False, [POS4], [(4, "End")])],
+    [(1, "Normal"), (2, "Normal"), (3, "False"), (4, "True")])
+WAVE_OLD = flowchart_old(
+    [("SetCounter1", "SetCounter", True, [SET_COUNTER], [(0, "", 0), (1, "Begin", 0), (0, "", 0), (0, "", 0)]),
+     ("Pos2", "Pos", False, [POS2], [(1, "End", 0), (2, "Begin", 0), (3, "End", 0), (0, "", 0)]),
+     ("Loop3", "Loop", False, LOOP, [(2, "End", 0), (3, "Begin", 1), (0, "", 0), (4, "Begin", 4)]),
+     ("Pos4", "Pos", False, [POS4], [(4, "End", 0), (0, "", 0), (0, "", 0), (0, "", 0)])],
+    [1, 2, 3, 4])
+# A Wait (0.8 s: MOV 8 -> timer 0; SUB timer 0 - 0x8000; JUMP back to the SUB while it is not 0,
+# its target left from an older build at 0x0012AB) then a MotionJump calling motion 2 of the
+# 2.0-2.1 layout (0x0013B8), then a pose: §5.5's patterns.
+WAIT = [[0x09, 0x00, 0x02, 0x3C, 0x00, 0x00, 0x08, 0x00, 0x4F], [0x09, 0x07, 0x82, 0x3C, 0x00, 0x00, 0x00, 0x80, 0x4E],
+        frame(0x0B, 0xAB, 0x12, 0x00, 0x04)]
+CALL2 = [frame(0x0C, 0xB8, 0x13, 0x00, 0x00)]
+WAIT_CALL = flowchart_new(
+    [("Pos1", "Pos", True, [POS2], [(1, "Begin")]),
+     ("Wait2", "Wait", False, WAIT, [(1, "End"), (2, "Begin")]),
+     ("MotionJump3", "MotionJump", False, CALL2, [(2, "End"), (3, "Begin")]),
+     ("Pos4", "Pos", False, [POS4], [(3, "End")])],
+    [(1, "Normal"), (2, "Normal"), (3, "Normal")])
+
 for name, content in [("three_motions.h4p", project(0x0B80)), ("three_motions_2_0.h4p", project(0x0BB8)),
-                      ("trims.h4t", trims())]:
+                      ("trims.h4t", trims()), ("wave_twice.xml", WAVE_NEW), ("wave_twice_old.xml", WAVE_OLD),
+                      ("wait_and_call.xml", WAIT_CALL)]:
     with open(os.path.join(HERE, name), "w", newline="") as f:
         f.write(content)

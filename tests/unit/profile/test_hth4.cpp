@@ -3,6 +3,7 @@
 // for byte, relocated between layouts as hth4-files.md §4 shows, and every kind of bad file
 // refused with its file, line and element.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/robot/hth4/flowchart.hpp>
 #include <rcb4/robot/hth4/project.hpp>
 #include <rcb4/robot/hth4/trim_file.hpp>
 
@@ -215,5 +216,72 @@ TEST_CASE("hth4: a trim file read, written back byte for byte, and its mistakes"
             .find("40 is out of range") != std::string::npos);
   CHECK(error_of(edit(text, "PositionData", "ServoItem")).find("xsi:type is 'ServoItem'") != std::string::npos);
   CHECK(error_of(data("three_motions.h4p")).find("root element is <Rcb4>, not <ArrayOfDictionaryEntry>") !=
+        std::string::npos);
+}
+
+TEST_CASE("hth4: flowcharts compile by HTH4's layout rule, in both schemas (hth4-files.md 5)", "[hth4]") {
+  // §5.7: the four-block flowchart compiles at 0x0B80 to §2.6's MotionData, the placeholder filled.
+  const auto project = parse_project(data("three_motions.h4p"), "p.h4p");
+  for (const char* name : {"wave_twice.xml", "wave_twice_old.xml"}) {
+    INFO(name);
+    const auto f = parse_flowchart(data(name), name);
+    CHECK(f.old_schema == (std::string(name) == "wave_twice_old.xml"));
+    REQUIRE(f.blocks.size() == 4);
+    CHECK(f.blocks[2].base_name == "Loop");
+    const auto c = compile_flowchart(f, 0x0B80, rcb4::hth4_2_2, name);
+    CHECK(c.frames == project.motions[0].frames);
+    CHECK(c.notes.empty());
+  }
+  // A Wait's JUMP back goes to its own SUB where it now lies; a call of the 2.0 layout's motion 2
+  // (0x0013B8) moves to 2.2's (0x001380).
+  const auto w =
+      compile_flowchart(parse_flowchart(data("wait_and_call.xml"), "w.xml"), 0x0B80, rcb4::hth4_2_2, "w.xml");
+  REQUIRE(w.frames.size() == 8);
+  CHECK(w.frames[1] == bytes{0x09, 0x00, 0x02, 0x3C, 0x00, 0x00, 0x08, 0x00, 0x4F});  // at 0x0B8D
+  CHECK(w.frames[3] == bytes{0x07, 0x0B, 0x96, 0x0B, 0x00, 0x04, 0xB7});              // back to 0x0B96
+  CHECK(w.frames[4] == bytes{0x07, 0x0C, 0x80, 0x13, 0x00, 0x00, 0xA6});              // CALL motion 2
+  CHECK(w.frames[6] == bytes{0x03, 0x0D, 0x10});
+  CHECK(w.frames[7] == bytes{0x03, 0x0D, 0x10, 0xFF});
+  REQUIRE(w.notes.size() == 1);
+  CHECK(w.notes[0].find("0x0013B8 moved to 0x001380") != std::string::npos);
+}
+
+TEST_CASE("hth4: bad flowcharts are refused with their file, line and block", "[hth4]") {
+  const auto good = data("wave_twice.xml");
+  const auto error_of = [](const std::string& text) {
+    try {
+      compile_flowchart(parse_flowchart(text, "f.xml"), 0x0B80, rcb4::hth4_2_2, "f.xml");
+    } catch (const profile_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"<?xml version=\"1.0\"?>\r\n<Rcb4 />", "root element is <Rcb4>, not <CanvasData>"},
+      {edit(good, "<MotionFlag>Start</MotionFlag>", "<MotionFlag>None</MotionFlag>"), "no block is the Start"},
+      {edit(good, "<MotionFlag>None</MotionFlag>", "<MotionFlag>Start</MotionFlag>"), "a second Start block"},
+      {edit(good, "<MotionFlag>None</MotionFlag>", "<MotionFlag>Begin</MotionFlag>"), "'Begin' is not Start or None"},
+      {edit(good, "<ConnectMode>True</ConnectMode>", "<ConnectMode>Normal</ConnectMode>"),
+       "two lines leave it the same way"},
+      {edit(good, "<ConnectMode>True</ConnectMode>", "<ConnectMode>Maybe</ConnectMode>"),
+       "'Maybe' is not Normal, True or False"},
+      {edit(good, "07 0B FF FF FF 05 14", "07 0B FF FF FF 05 15"), "SIZE byte or SUM does not match"},
+      {edit(good, "08 07 02 57 04 00 01 6D</anyType>\r\n        <anyType xsi:type=\"xsd:string\">07 0B FF FF FF 05 14",
+            "08 07 02 57 04 00 01 6D"),
+       "a True line leaves it, but its code has no JUMP waiting for it"},
+      {edit(good, "EndConnect,BeginConnect,BeginConnect", "EndConnect,BeginConnect,EndConnect"),
+       "each line joins exactly two"},
+      {edit(good, "a0000000-0000-4000-8000-000000000004</GUID>", "a0000000-0000-4000-8000-000000000009</GUID>"),
+       "which is not in the file"},
+  };
+  for (const auto& [text, says] : cases) {
+    const auto e = error_of(text);
+    INFO(says << " -> " << e);
+    CHECK(e.rfind("f.xml", 0) == 0);
+    CHECK(e.find(says) != std::string::npos);
+  }
+  // A call that names no slot's start.
+  const auto w = edit(data("wait_and_call.xml"), "07 0C B8 13 00 00 DE", "07 0C B9 13 00 00 DF");
+  CHECK(error_of(w).find("block 'MotionJump3' (MotionJump): 0x0013B9 is not the start of a motion slot") !=
         std::string::npos);
 }
