@@ -9,6 +9,7 @@
 # SPDX-License-Identifier: BSL-1.0
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -165,10 +166,33 @@ with serve() as dev:
     rc, out, err = run(*on, "motion", "play", "22", "--wait", "--timeout", "10")
     check(rc == 0 and "done after" in out, f"the imported motion plays (a Wait of 0.8 s, a call) ({rc}: {out!r} {err!r})")
 
+    # --to DIR: the project as rcb4's files (no board), and its push.sh puts the same bytes back.
+    rc, out, err = run("project", "import", PROJECT, "--to", "asfiles")
+    files = sorted(os.listdir("asfiles")) if rc == 0 else []
+    check(rc == 0 and files == ["001-wave_twice.yaml", "002-bow.yaml", "003-bow_and_home.yaml", "profile.yaml",
+                                "push.sh", "trims.h4t"], f"project import --to: a profile, motion files, trims, push.sh ({rc}: {files} {err!r})")
+    rc, out, err = run("project", "import", PROJECT, "--to", "asfiles")
+    check(rc == 2 and "not empty" in err, f"--to into a directory that is not empty: exit 2 ({err.strip()!r})")
+    # (Slot 1 gets other code: erased, the board's layout could no longer be told.)
+    rcs = [run(*on, "motion", "push", "loop.yaml", "1", "--backup", "e1.bin")[0],
+           run(*on, "motion", "erase", "3", "--backup", "e3.bin")[0], run(*on, "motion", "erase", "2", "--backup", "e2.bin")[0]]
+    check(rcs == [0, 0, 0] and rom(on, 0x1380, 1) == b"\xff", f"slots 1-3 changed before push.sh ({rcs})")
+    p = subprocess.run(["sh", "asfiles/push.sh"], capture_output=True, text=True, timeout=120,
+                       env=dict(os.environ, RCB4=f"{RCB4} --device {dev}"))
+    want = {1: "0800025704000267 0D100C000000001478 1E201C0F 080702570400016D 070BAB0B0005CD 070B880B0000A5 "
+               "0D100C000000001E4C1D4C1D19 030D10",
+            3: "070C80130000A6"}
+    check(p.returncode == 0 and rom(on, 0x0B80, 59) == bytes.fromhex(want[1].replace(" ", ""))
+          and rom(on, 0x1B80, 7) == bytes.fromhex(want[3]),
+          f"push.sh writes the project's bytes back (callee first) ({p.returncode}: {p.stderr[-300:]!r})")
+    rc, out, err = run(*on, "motion", "buttons")
+    check("right+s1" in out and "plays motion 1" in out, f"push.sh set the button ({out!r})")
+
     # Power-on: the start-up motion (HTH4's CALL at 0x0444) and the boot config word.
     # (The import wrote the project's StartupMotionAddress, 2944: motion 1.)
     rc, out, err = run(*on, "motion", "startup")
-    check(rc == 0 and 'motion 1 "wave_twice" (0x000B80) plays at power-on' in out, f"motion startup: the project's ({out!r})")
+    check(rc == 0 and out.startswith("motion 1 ") and "(0x000B80) plays at power-on" in out,
+          f"motion startup: the project's ({out!r})")
     rc, out, err = run(*on, "motion", "startup", "none")
     check(rc == 0 and "no start-up motion" in out and rom(on, 0x0444, 7) == bytes.fromhex("070C80CB030061"),
           f"motion startup none: DefaultStartup, 07 0C 80 CB 03 00 61 ({out!r})")

@@ -8,6 +8,7 @@
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/robot/hth4/flowchart.hpp>
 #include <rcb4/robot/hth4/project.hpp>
+#include <rcb4/robot/hth4/to_files.hpp>
 #include <rcb4/robot/hth4/trim_file.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
@@ -15,6 +16,7 @@
 #include <rcb4/robot/services/trims.hpp>
 
 #include <filesystem>
+#include <fstream>
 
 namespace cli {
 namespace ro = rcb4::robot;
@@ -33,9 +35,48 @@ h4::project load(const std::string& file) {
 
 struct import_options {
   motion_options m;
-  std::string file;
-  bool dry_run = false, project_baud = false;
+  std::string file, to;
+  bool dry_run = false, project_baud = false, force = false;
 };
+
+/** project import FILE --to DIR: the project as rcb4's files (no board needed). */
+int import_to(const import_options& o, const globals& g) {
+  const auto p = load(o.file);
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(o.to) && !fs::is_empty(o.to, ec) && !o.force)
+    throw usage_error(fmt::format("--to: {} exists and is not empty (--force writes into it)", o.to));
+  h4::project_files files;
+  try {
+    files = h4::project_as_files(p, p.name.empty() ? fs::path(o.file).stem().string() : p.name);
+  } catch (const rcb4::robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  fs::create_directories(o.to, ec);
+  if (ec) throw usage_error(fmt::format("--to: cannot create {}: {}", o.to, ec.message()));
+  for (const auto& f : files.files) {
+    const auto path = fs::path(o.to) / f.name;
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (f.bytes.empty())
+      out << f.text;
+    else
+      out.write(reinterpret_cast<const char*>(f.bytes.data()), static_cast<std::streamsize>(f.bytes.size()));
+    if (!out.flush()) throw usage_error(fmt::format("--to: cannot write {}", path.string()));
+    if (f.name == "push.sh")
+      fs::permissions(path, fs::perms::owner_exec | fs::perms::group_exec, fs::perm_options::add, ec);
+  }
+  if (g.json) {
+    json names = json::array();
+    for (const auto& f : files.files) names.push_back(f.name);
+    emit(json{{"project", o.file}, {"to", o.to}, {"files", names}, {"notes", files.notes}});
+    return exit_ok;
+  }
+  fmt::print("{} -> {}: {} files\n", o.file, o.to, files.files.size());
+  for (const auto& f : files.files) fmt::print("  {}\n", f.name);
+  for (const auto& n : files.notes) fmt::print("note: {}\n", n);
+  fmt::print("sh {}/push.sh puts it on a board (RCB4=\"rcb4 --device PORT\")\n", o.to);
+  return exit_ok;
+}
 
 int import(session& s, const import_options& o, const globals& g) {
   const auto p = load(o.file);
@@ -284,12 +325,24 @@ void add_project_commands(CLI::App& app, context& ctx) {
       "buttons, servos and trims, config word, AD references, start-up motion; the ROM saved first "
       "(rom-before-import-DATE.bin), only what differs written, each piece read back");
   imp->add_option("FILE", io->file, "an HTH4 project (.h4p, HTH4 2.x)")->required();
+  imp->add_option("--to", io->to,
+                  "no board: write the project as rcb4's files into DIR (profile.yaml, a motion file per motion, "
+                  "trims.h4t, push.sh)");
+  imp->add_flag("--force", io->force, "with --to: write into a directory that is not empty");
   imp->add_flag("--dry-run", io->dry_run, "list every area and whether it would change; write nothing");
   imp->add_flag("--project-baud", io->project_baud,
                 "take the COM baud from the project's config word too (default: keep the board's, so the link "
                 "survives a power cycle)");
   add_layout(imp, io->m);
-  on_device(imp, ctx, [&ctx, io](session& s) { return import(s, *io, ctx.g); });
+  imp->callback([&ctx, io] {
+    if (!io->to.empty())
+      ctx.action = [&ctx, io] { return import_to(*io, ctx.g); };
+    else
+      ctx.action = [&ctx, io] {
+        session s(ctx.g);
+        return import(s, *io, ctx.g);
+      };
+  });
 
   struct export_options {
     motion_options m;

@@ -5,6 +5,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/robot/hth4/flowchart.hpp>
 #include <rcb4/robot/hth4/project.hpp>
+#include <rcb4/robot/hth4/to_files.hpp>
 #include <rcb4/robot/hth4/trim_file.hpp>
 
 #include <catch2/catch.hpp>
@@ -284,4 +285,31 @@ TEST_CASE("hth4: bad flowcharts are refused with their file, line and block", "[
   const auto w = edit(data("wait_and_call.xml"), "07 0C B8 13 00 00 DE", "07 0C B9 13 00 00 DF");
   CHECK(error_of(w).find("block 'MotionJump3' (MotionJump): 0x0013B9 is not the start of a motion slot") !=
         std::string::npos);
+}
+
+TEST_CASE("hth4: a project as rcb4's files", "[hth4]") {
+  CHECK(identifier("Left Knee") == "left_knee");
+  CHECK(identifier("2nd-arm") == "j_2nd_arm");
+  CHECK(identifier("--") == "");
+  const auto p = parse_project(data("three_motions.h4p"), "p.h4p");
+  const auto f = project_as_files(p, "");
+  std::vector<std::string> names;
+  for (const auto& x : f.files) names.push_back(x.name);
+  CHECK(names == std::vector<std::string>{"profile.yaml", "001-wave_twice.yaml", "002-bow.yaml",
+                                          "003-bow_and_home.yaml", "trims.h4t", "push.sh"});
+  // The profile reads, with the seven allocated servos as joints.
+  const auto m = parse_profile(f.files[0].text, "profile.yaml");
+  CHECK(m.name() == "three_motions");
+  CHECK(m.joints().size() == 7);
+  REQUIRE(m.find("left_knee"));
+  CHECK(m.find("left_knee")->ics.value() == 16);
+  // push.sh sets the period first and pushes motion 2 before motion 3, which calls it.
+  const auto& sh = f.files.back().text;
+  CHECK(sh.find("config set period=15 --persist") < sh.find("motion push"));
+  CHECK(sh.find("002-bow.yaml 2") < sh.find("003-bow_and_home.yaml 3"));
+  CHECK(sh.find("motion buttons set right+s1 1") != std::string::npos);
+  // A project without an allocated servo describes no robot.
+  auto none = p;
+  for (auto& s : none.servos) s.mode = servo_mode::none;
+  CHECK_THROWS_AS(project_as_files(none, ""), profile_error);
 }
