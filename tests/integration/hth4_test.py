@@ -169,8 +169,8 @@ with serve() as dev:
     # --to DIR: the project as rcb4's files (no board), and its push.sh puts the same bytes back.
     rc, out, err = run("project", "import", PROJECT, "--to", "asfiles")
     files = sorted(os.listdir("asfiles")) if rc == 0 else []
-    check(rc == 0 and files == ["001-wave_twice.yaml", "002-bow.yaml", "003-bow_and_home.yaml", "profile.yaml",
-                                "push.sh", "trims.h4t"], f"project import --to: a profile, motion files, trims, push.sh ({rc}: {files} {err!r})")
+    check(rc == 0 and files == ["001-wave_twice.yaml", "002-bow.yaml", "003-bow_and_home.yaml", "buttons.yaml",
+                                "profile.yaml", "push.sh", "trims.h4t"], f"project import --to: a profile, motion files, trims, push.sh ({rc}: {files} {err!r})")
     rc, out, err = run("project", "import", PROJECT, "--to", "asfiles")
     check(rc == 2 and "not empty" in err, f"--to into a directory that is not empty: exit 2 ({err.strip()!r})")
     # (Slot 1 gets other code: erased, the board's layout could no longer be told.)
@@ -187,6 +187,14 @@ with serve() as dev:
           f"push.sh writes the project's bytes back (callee first) ({p.returncode}: {p.stderr[-300:]!r})")
     rc, out, err = run(*on, "motion", "buttons")
     check("right+s1" in out and "plays motion 1" in out, f"push.sh set the button ({out!r})")
+    # And the directory back as a project (no board): the same motions, frame for frame.
+    rc, out, err = run("project", "export", "fromdir.h4p", "--from", "asfiles")
+    run(*on, "project", "import", PROJECT)
+    rc2, out2, err2 = run(*on, "project", "import", "fromdir.h4p", "--dry-run")
+    changed = [l for l in out2.splitlines() if l.startswith("  change")]
+    check(rc == 0 and rc2 == 0 and changed == ["  change 0x0008F6  AD references"],
+          f"project export --from DIR: the project's motions, buttons and trims again (only the AD references, which "
+          f"a directory does not hold, differ) ({rc}, {rc2}: {changed} {err.strip()!r} {err2.strip()!r})")
 
     # Power-on: the start-up motion (HTH4's CALL at 0x0444) and the boot config word.
     # (The import wrote the project's StartupMotionAddress, 2944: motion 1.)

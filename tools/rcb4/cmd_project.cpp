@@ -163,6 +163,29 @@ int export_to(session& s, const motion_options& m, const std::string& file, bool
   return exit_ok;
 }
 
+/** project export FILE --from DIR: rcb4's files as a project (no board). */
+int export_from(const std::string& dir, const std::string& file, bool force, const globals& g) {
+  if (std::filesystem::exists(file) && !force)
+    throw usage_error(fmt::format("FILE: {} exists (--force replaces it)", file));
+  if (!std::filesystem::is_directory(dir)) throw usage_error(fmt::format("--from: {} is not a directory", dir));
+  h4::project p;
+  try {
+    p = h4::load_project_dir(dir);
+    p.file_name = std::filesystem::absolute(file).string();
+    p.path = std::filesystem::absolute(file).parent_path().string();
+    h4::save_project(file, p);
+  } catch (const rcb4::robot::profile_error& e) {
+    throw usage_error(e.what());
+  }
+  const auto used = std::count_if(p.motions.begin(), p.motions.end(), [](const auto& x) { return !x.frames.empty(); });
+  if (g.json)
+    emit(json{{"file", file}, {"from", dir}, {"motions", used}});
+  else
+    fmt::print("{} -> {}: {}, config 0x{:04X}\n", dir, file, plural(static_cast<std::size_t>(used), "motion"),
+               p.config);
+  return exit_ok;
+}
+
 int trim_import(session& s, const std::string& file, bool persist, const globals& g) {
   std::vector<h4::trim_entry> entries;
   try {
@@ -346,7 +369,7 @@ void add_project_commands(CLI::App& app, context& ctx) {
 
   struct export_options {
     motion_options m;
-    std::string file;
+    std::string file, from;
     bool force = false;
   };
   auto eo = std::make_shared<export_options>();
@@ -356,8 +379,20 @@ void add_project_commands(CLI::App& app, context& ctx) {
       "slot's code and name, the buttons, the start-up motion");
   exp->add_option("FILE", eo->file, "the project to write")->required();
   exp->add_flag("--force", eo->force, "replace FILE when it exists");
+  exp->add_option(
+      "--from", eo->from,
+      "no board: a directory of rcb4 files instead (profile.yaml, NNN-name.yaml motion files, buttons.yaml, "
+      "trims.h4t: what project import --to writes)");
   add_layout(exp, eo->m);
-  on_device(exp, ctx, [&ctx, eo](session& s) { return export_to(s, eo->m, eo->file, eo->force, ctx.g); });
+  exp->callback([&ctx, eo] {
+    if (!eo->from.empty())
+      ctx.action = [&ctx, eo] { return export_from(eo->from, eo->file, eo->force, ctx.g); };
+    else
+      ctx.action = [&ctx, eo] {
+        session s(ctx.g);
+        return export_to(s, eo->m, eo->file, eo->force, ctx.g);
+      };
+  });
 }
 
 void add_trim_import(CLI::App* trim, context& ctx) {

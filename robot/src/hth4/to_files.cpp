@@ -8,6 +8,9 @@
 
 #include <fmt/format.h>
 
+#include <fstream>
+#include <iterator>
+
 #include <map>
 #include <set>
 
@@ -114,7 +117,7 @@ project_files project_as_files(const project& p, const std::string& robot) {
       });
       if (!ready && round < items.size()) continue;
       sh +=
-          fmt::format("$RCB4 --robot profile.yaml motion push {} {} --backup {:03d}-before.bin\n", it.file, it.n, it.n);
+          fmt::format("$RCB4 --robot profile.yaml motion push {} {} --backup before-{:03d}.bin\n", it.file, it.n, it.n);
       pushed.insert(it.n);
     }
   for (const auto& mo : p.motions) {
@@ -127,9 +130,113 @@ project_files project_as_files(const project& p, const std::string& robot) {
     sh += fmt::format("$RCB4 motion buttons set {} {}\n", motion::buttons_text(mo.buttons), mo.number + 1);
   }
   sh += "$RCB4 trim import trims.h4t --persist\n";
+  std::string buttons = "# which KRR buttons play which motion (rcb4 project export --from reads it)\n";
+  for (const auto& mo : p.motions)
+    if (!mo.frames.empty() && mo.buttons != 0 && mo.compare == compare_type::equals)
+      buttons += fmt::format("{}: {}\n", motion::buttons_text(mo.buttons), mo.number + 1);
+  out.files.push_back({"buttons.yaml", buttons, {}});
   out.files.push_back({"trims.h4t", trim_file_xml(trims_of(p)), {}});
   out.files.push_back({"push.sh", sh, {}});
   return out;
+}
+
+project load_project_dir(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  const auto m = load_profile(dir / "profile.yaml");
+  project p = empty_project(hth4_2_2);
+  p.name = m.name();
+  for (const auto& j : m.joints()) {
+    const auto k = j.ics.value();
+    if (k >= servo_count) continue;
+    p.servos[k].name = j.name;
+    p.servos[k].mode = servo_mode::normal;
+  }
+  std::optional<output_period> period;
+  std::error_code ec;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir, ec)) files.push_back(e.path());
+  if (ec) throw profile_error(dir.string(), "cannot read: " + ec.message());
+  std::sort(files.begin(), files.end());
+  static constexpr std::uint8_t tail[] = {0x03, 0x0D, 0x10, 0xFF};
+  const std::vector<std::uint8_t> ret = {0x03, 0x0D, 0x10};
+  for (const auto& f : files) {
+    const auto stem = f.stem().string();
+    if (stem.size() < 5 || !std::isdigit(static_cast<unsigned char>(stem[0])) ||
+        !std::isdigit(static_cast<unsigned char>(stem[1])) || !std::isdigit(static_cast<unsigned char>(stem[2])) ||
+        stem[3] != '-' || (f.extension() != ".yaml" && f.extension() != ".bin"))
+      continue;
+    const auto n = static_cast<unsigned>(std::stoul(stem.substr(0, 3)));
+    if (n < 1 || n > motion_count) throw profile_error(f.string(), "names slot " + std::to_string(n) + " (1..120)");
+    auto& mo = p.motions[n - 1];
+    if (!mo.frames.empty()) throw profile_error(f.string(), "a second file for slot " + std::to_string(n));
+    const auto where = motion::slot_of(hth4_2_2, n).value();
+    std::vector<std::uint8_t> code;
+    if (f.extension() == ".yaml") {
+      const auto d = load_motion(f, m);
+      if (period && *period != d.period)
+        throw profile_error(f.string(), "is made for another output period than the other motion files");
+      period = d.period;
+      const auto c = to_program(d, m, hth4_2_2, d.period);
+      if (!ok(c)) throw profile_error(f.string(), std::get<problem>(c).message);
+      const auto b = motion::assemble(std::get<compiled_motion>(c).program, where);
+      if (!motion::ok(b)) throw profile_error(f.string(), std::get<motion::failure>(b).message);
+      code = std::get<std::vector<std::uint8_t>>(b);
+      mo.name = d.name.empty() ? stem.substr(4) : d.name;
+    } else {
+      std::ifstream in(f, std::ios::binary);
+      code.assign(std::istreambuf_iterator<char>(in), {});
+      if (code.size() > where.size) throw profile_error(f.string(), "is longer than a slot");
+      mo.name = stem.substr(4);
+    }
+    // The frames in a row, then HTH4's tail after them (hth4-files.md §5.6 step 3); a .bin that
+    // ends in a RETURN and one FF already has it (§2.2).
+    bool return_ff = false;
+    for (std::size_t at = 0; at < code.size();) {
+      const std::size_t size = code[at];
+      if (size < min_frame_size || at + size > code.size()) {
+        const auto rest = code.size() - at;
+        if (rest == 4 && std::equal(code.begin() + static_cast<std::ptrdiff_t>(at), code.end(), tail)) break;
+        if (rest == 1 && code[at] == 0xFF && !mo.frames.empty() && mo.frames.back() == ret) {
+          return_ff = true;
+          break;
+        }
+        throw profile_error(f.string(), "byte " + std::to_string(at) + " does not start a frame");
+      }
+      mo.frames.emplace_back(code.begin() + static_cast<std::ptrdiff_t>(at),
+                             code.begin() + static_cast<std::ptrdiff_t>(at + size));
+      at += size;
+    }
+    if (return_ff) mo.frames.pop_back();
+    mo.frames.emplace_back(std::begin(tail), std::end(tail));
+  }
+  auto config = config_word::decode(0x801B);  // ICS, program and vector switch on (hth4-files.md §2.1's GSU word)
+  if (period) config.period = *period;
+  p.config = config.encode();
+  if (const auto file = dir / "buttons.yaml"; fs::exists(file)) {
+    std::ifstream in(file);
+    std::string line;
+    for (unsigned no = 1; std::getline(in, line); ++no) {
+      if (line.empty() || line[0] == '#') continue;
+      const auto where = file.string() + ":" + std::to_string(no);
+      const auto colon = line.find(':');
+      if (colon == std::string::npos) throw profile_error(where, "a line is BUTTONS: N");
+      const auto word = motion::parse_buttons(line.substr(0, colon));
+      if (!motion::ok(word)) throw profile_error(where, std::get<motion::failure>(word).message);
+      unsigned n = 0;
+      try {
+        n = static_cast<unsigned>(std::stoul(line.substr(colon + 1)));
+      } catch (const std::exception&) {
+      }
+      if (n < 1 || n > motion_count || p.motions[n - 1].frames.empty())
+        throw profile_error(where, "names no motion of this directory");
+      p.motions[n - 1].buttons = std::get<std::uint16_t>(word);
+    }
+  }
+  if (fs::exists(dir / "trims.h4t"))
+    for (const auto& t : load_trim_file(dir / "trims.h4t"))
+      if (t.device_number < servo_count) p.servos[t.device_number].trim = t.trim;
+  check_project(p, dir.string());
+  return p;
 }
 
 }  // namespace rcb4::robot::hth4

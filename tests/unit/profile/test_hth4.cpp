@@ -296,7 +296,8 @@ TEST_CASE("hth4: a project as rcb4's files", "[hth4]") {
   std::vector<std::string> names;
   for (const auto& x : f.files) names.push_back(x.name);
   CHECK(names == std::vector<std::string>{"profile.yaml", "001-wave_twice.yaml", "002-bow.yaml",
-                                          "003-bow_and_home.yaml", "trims.h4t", "push.sh"});
+                                          "003-bow_and_home.yaml", "buttons.yaml", "trims.h4t", "push.sh"});
+  CHECK(f.files[4].text.find("right+s1: 1\n") != std::string::npos);
   // The profile reads, with the seven allocated servos as joints.
   const auto m = parse_profile(f.files[0].text, "profile.yaml");
   CHECK(m.name() == "three_motions");

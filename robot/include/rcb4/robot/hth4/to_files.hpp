@@ -9,6 +9,7 @@
 #include <rcb4/robot/hth4/project.hpp>
 
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -22,7 +23,7 @@ struct project_files {
     std::string text;
     std::vector<std::uint8_t> bytes;
   };
-  std::vector<file> files;         ///< profile.yaml, NNN-name.yaml / .bin, trims.h4t, push.sh
+  std::vector<file> files;         ///< profile.yaml, NNN-name.yaml / .bin, buttons.yaml, trims.h4t, push.sh
   std::vector<std::string> notes;  ///< what is kept as code, what is left out, and why
 };
 
@@ -33,6 +34,15 @@ struct project_files {
  * is 2.0). @p robot names the robot (empty: the project's Name).
  */
 project_files project_as_files(const project& p, const std::string& robot);
+
+/**
+ * A directory of rcb4's files (what --to writes, or the same by hand) as a project: profile.yaml's
+ * joints as allocated servos; each `NNN-name.yaml` motion file assembled into slot NNN of the 2.2
+ * layout (`NNN-name.bin`: its bytes as they are); buttons.yaml (`BUTTONS: N` lines) and trims.h4t
+ * where present; the config word's period from the motion files. Throws profile_error naming the
+ * file and what is wrong.
+ */
+project load_project_dir(const std::filesystem::path& dir);
 
 /** @p name as a joint name: lower case letters, digits and `_`, not starting with a digit; empty stays empty. */
 std::string identifier(std::string_view name);
