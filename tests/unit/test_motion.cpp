@@ -140,6 +140,13 @@ TEST_CASE("motion: what cannot be read back is named, never made up", "[motion]"
   const auto o = disassemble(out, hth4_2_0_motion_1);
   REQUIRE(o.problems.size() == 1);
   CHECK(o.problems[0] == "0x000BB8: jumps out of the slot, to 0x010000");
+  // HTH4's terminal MotionJump: a JUMP to another slot's first byte is a way out, like a call.
+  const std::vector<std::uint8_t> tail_jump = {0x07, 0x0B, 0xB8, 0x13, 0x00, 0x00, 0xDD};  // JUMP 0x0013B8 (motion 2)
+  const auto t = disassemble(tail_jump, hth4_2_0_motion_1);
+  CHECK(t.problems.empty());
+  CHECK(t.calls == std::vector<std::uint32_t>{0x0013B8});
+  CHECK(t.notes.at(0) ==
+        "0x000BB8: jumps to 0x0013B8 (another motion): the board goes on there and does not come back");
   // Code that runs for ever: listed, with a note.
   const std::vector<std::uint8_t> forever = {0x07, 0x0B, 0xB8, 0x0B, 0x00, 0x00, 0xD5};  // JUMP 0x000BB8
   const auto f = disassemble(forever, hth4_2_0_motion_1);

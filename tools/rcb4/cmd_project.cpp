@@ -13,6 +13,7 @@
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/project.hpp>
+#include <rcb4/robot/services/slot_names.hpp>
 #include <rcb4/robot/services/trims.hpp>
 
 #include <filesystem>
@@ -291,6 +292,7 @@ int flow_push(session& s, const flow_options& o, const globals& g) {
   const auto r = sv::push_motion(
       link, robot_of(g), layout, n, src,
       [&](unsigned motion, std::span<const std::uint8_t> old) { return sv::save_backup_file(motion, old, o.backup); });
+  sv::set_slot_name(robot_of(g).name(), n, std::filesystem::path(o.file).stem().string());
   if (g.json) {
     emit(json{{"file", o.file},
               {"pushed", n},

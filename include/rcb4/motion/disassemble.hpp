@@ -32,9 +32,9 @@ struct instruction {
 
 /** The reachable code of a slot. */
 struct listing {
-  slot where;                         ///< the slot read
-  std::vector<instruction> code;      ///< every reachable frame, by address
-  std::vector<std::uint32_t> calls;   ///< the addresses it CALLs (other motions), ascending
+  slot where;                        ///< the slot read
+  std::vector<instruction> code;     ///< every reachable frame, by address
+  std::vector<std::uint32_t> calls;  ///< the addresses it CALLs or JUMPs to outside the slot (other motions), ascending
   std::vector<std::string> problems;  ///< what stops the board: a bad frame, a jump out of the slot, ...
   std::vector<std::string> notes;     ///< what runs but may not be meant: a jump to itself, a call of itself
 };
@@ -88,7 +88,19 @@ inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, cons
         todo.push_back(target);
     };
     if (const auto* j = std::get_if<jump>(&r.value)) {
-      follow(j->target().value());
+      const auto t = j->target().value();
+      const bool other_slot_start = (t < base ? base - t : t - base) % where.size == 0;
+      if ((t < base || t >= base + where.size) && other_slot_start) {
+        // HTH4's terminal MotionJump (hth4-files.md §4, §5.5): the board goes on in another
+        // motion (a slot's first byte, slots being where.size apart) and does not come back. Its target is checked as a
+        // call's is (callers treat it as one: an empty or broken slot is refused, and it counts towards the nesting
+        // depth).
+        calls.insert(t);
+        out.notes.push_back(hex_address(at) + ": jumps to " + hex_address(t) +
+                            " (another motion): the board goes on there and does not come back");
+      } else {
+        follow(t);
+      }
       if (j->cond() != condition::always())
         todo.push_back(next);
       else if (j->target().value() == at)
@@ -173,7 +185,8 @@ inline outcome<program> lift(const listing& l) {
         p.steps.push_back(count_down{at, to, *cond.zero});
       } else {
         const auto how = detail::compare_of(then->cond());
-        if (!how) return cannot("a compare with a condition that is not one of equal, not equal, below, at least, at most");
+        if (!how)
+          return cannot("a compare with a condition that is not one of equal, not equal, below, at least, at most");
         p.steps.push_back(branch_if{at, a->src().size(), detail::literal_value(a->src()), *how, to});
       }
       ++i;  // the JUMP belongs to this step

@@ -8,6 +8,7 @@
 #include <rcb4/motion/disassemble.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <set>
 
@@ -166,6 +167,51 @@ void check_project(const project& p, const where_fn& where) {
         throw profile_error(where({place::in_frame, static_cast<unsigned>(i), static_cast<unsigned>(j)}),
                             std::string(f[1] == jump::command_code ? "JUMP" : "CALL") + " to " + hex(t) + ": " + why);
     }
+  // Calls (and terminal JUMPs to another slot) must not come back round, and must nest no deeper
+  // than the board's 16-level stack with the main loop's CALL (protocol.md §4.4): what a push refuses.
+  std::vector<std::vector<std::size_t>> callees(motion_count);
+  std::vector<std::vector<std::size_t>> via(motion_count);  // the frame of each call, for messages
+  for (std::size_t i = 0; i < motion_count; ++i)
+    for (std::size_t j = 0; j + 1 < p.motions[i].frames.size(); ++j) {
+      const auto& f = p.motions[i].frames[j];
+      if (f.size() != 7 || (f[1] != jump::command_code && f[1] != call::command_code)) continue;
+      const std::uint32_t t = f[2] | (f[3] << 8) | (static_cast<std::uint32_t>(f[4]) << 16);
+      const std::size_t s = (t - base) / slot;
+      if (s != i || f[1] == call::command_code) {
+        callees[i].push_back(s);
+        via[i].push_back(j);
+      }
+    }
+  std::vector<int> state(motion_count, 0);  // 0 new, 1 on the path, 2 done
+  std::vector<unsigned> depth(motion_count, 0);
+  std::vector<std::size_t> path;
+  const std::function<void(std::size_t)> visit = [&](std::size_t i) {
+    state[i] = 1;
+    path.push_back(i);
+    unsigned d = 0;
+    for (std::size_t k = 0; k < callees[i].size(); ++k) {
+      const auto c = callees[i][k];
+      if (state[c] == 1) {
+        std::string chain;
+        for (auto it = std::find(path.begin(), path.end(), c); it != path.end(); ++it)
+          chain += std::to_string(*it + 1) + " -> ";
+        throw profile_error(where({place::in_frame, static_cast<unsigned>(i), static_cast<unsigned>(via[i][k])}),
+                            "the calls come back round (motion " + chain + std::to_string(c + 1) +
+                                "): the board's 16-level stack would overflow");
+      }
+      if (state[c] == 0) visit(c);
+      d = std::max(d, depth[c]);
+    }
+    depth[i] = d + 1;
+    if (depth[i] + 1 > 16)
+      throw profile_error(
+          where({place::in_motion, static_cast<unsigned>(i)}),
+          "its calls nest " + std::to_string(depth[i] + 1) + " deep with the main loop's: the board's stack holds 16");
+    path.pop_back();
+    state[i] = 2;
+  };
+  for (std::size_t i = 0; i < motion_count; ++i)
+    if (state[i] == 0 && !p.motions[i].frames.empty()) visit(i);
   // The start-up and priority motions: none, or a used slot (the end of the area is 2.2's
   // DefaultStartup, a RETURN: DOC-PRG).
   const auto slot_start = [&](long a) {
@@ -204,8 +250,9 @@ void check_project(const project& p, const where_fn& where) {
                                            std::to_string(s.ram_address) + "; ICS " + std::to_string(k) +
                                            "'s is 20 bytes at " + std::to_string(0x0626 + 20 * k) + " and " +
                                            std::to_string(0x0090 + 20 * k));
-    if (s.trim < -32768 || s.trim > 32767)
-      throw profile_error(where(here), "Trim " + std::to_string(s.trim) + " does not fit the block's 16 bits");
+    if (s.mode == servo_mode::normal && (s.trim < -4000 || s.trim > 4000))
+      throw profile_error(where(here),
+                          "Trim " + std::to_string(s.trim) + " is beyond a servo's travel (+-4000 counts, 135 deg)");
     if (s.name.empty() || !names.insert(s.name).second)
       throw profile_error(where(here),
                           "the servo name '" + s.name + "' is " + (s.name.empty() ? "empty" : "used twice"));

@@ -62,11 +62,15 @@ import_plan plan_import(std::span<const std::uint8_t> rom, const project& p, con
     return a >= from && a < from + slots * board.slot_size ? a - from + to : a;
   };
   // 1. Motions (§10.1), relocated (§4).
-  unsigned empty_over_used = 0;
+  std::vector<std::string> empty_over_used;
   for (const auto& m : p.motions) {
     const std::uint32_t at = to + m.number * board.slot_size;
     if (m.frames.empty()) {
-      empty_over_used += plan.image[at] != 0xFF;
+      if (plan.image[at] != 0xFF) empty_over_used.push_back(std::to_string(m.number + 1));
+      if (m.buttons != 0)
+        plan.not_written.push_back("the button word " + std::to_string(m.buttons) + " of motion " +
+                                   std::to_string(m.number + 1) +
+                                   ", an empty slot (a press would stop the board's program)");
       continue;
     }
     std::vector<std::uint8_t> code;
@@ -77,10 +81,13 @@ import_plan plan_import(std::span<const std::uint8_t> rom, const project& p, con
             (from == to ? "" : ", moved from " + hex(m.address)) + ")",
         at, code);
   }
-  if (empty_over_used)
-    plan.not_written.push_back(std::to_string(empty_over_used) +
-                               " slot(s) empty in the project hold code on the board: left as they are (whether HTH4 "
-                               "erases them is unknown, hth4-files.md §11.7; `rcb4 motion erase N` empties one)");
+  if (!empty_over_used.empty()) {
+    std::string list;
+    for (const auto& n : empty_over_used) list += (list.empty() ? "" : ", ") + n;
+    plan.not_written.push_back("slots " + list +
+                               ": empty in the project, they hold code on the board and are left as they are (whether "
+                               "HTH4 erases them is unknown, hth4-files.md §11.7; `rcb4 motion erase N` empties one)");
+  }
   // 2. The button table (§9): CALL entries, in motion order.
   std::vector<vector_entry> entries;
   unsigned other_compare = 0;

@@ -98,8 +98,11 @@ project_files project_as_files(const project& p, const std::string& robot) {
   // push.sh: callees before callers (a push refuses a call of an empty slot).
   std::string sh = fmt::format(
       "#!/bin/sh\n# Puts the HTH4 project '{}' on a board of the HTH4 2.2+ layout with the rcb4 tool: its motions\n"
-      "# (each slot's old bytes backed up beside this script), buttons and trims. rcb4 project import\n"
-      "# --to wrote it; the board: RCB4_DEVICE, or --device in RCB4 (RCB4=\"rcb4 --device /dev/ttyUSB0\" sh push.sh).\n"
+      "# (each slot's old bytes backed up beside this script as motion-N-DATE.bin), buttons (the board's\n"
+      "# others cleared, as a project holds the whole table) and trims. Not the start-up motion, the AD\n"
+      "# references, HTH4's trailing 03 0D 10 FF or the allocation: `rcb4 project export P.h4p --from\n"
+      "# DIR` then `rcb4 project import P.h4p` writes all of that. rcb4 project import --to wrote this;\n"
+      "# the board: RCB4_DEVICE, or --device in RCB4 (RCB4=\"rcb4 --device /dev/ttyUSB0\" sh push.sh).\n"
       "set -e\ncd \"$(dirname \"$0\")\"\nRCB4=${{RCB4:-rcb4}}\n"
       "# The project's output period, which its motions' frames were made for (RAM and power-on).\n"
       "$RCB4 config set period={} --persist\n",
@@ -116,10 +119,10 @@ project_files project_as_files(const project& p, const std::string& robot) {
         return c == it.n || pushed.count(c);
       });
       if (!ready && round < items.size()) continue;
-      sh +=
-          fmt::format("$RCB4 --robot profile.yaml motion push {} {} --backup before-{:03d}.bin\n", it.file, it.n, it.n);
+      sh += fmt::format("$RCB4 --robot profile.yaml motion push {} {}\n", it.file, it.n);
       pushed.insert(it.n);
     }
+  sh += "$RCB4 motion buttons reset\n";
   for (const auto& mo : p.motions) {
     if (mo.frames.empty() || mo.buttons == 0) continue;
     if (mo.compare != compare_type::equals) {

@@ -32,6 +32,19 @@ class xml_in {
       throw profile_error(source_, "is " + std::to_string(text.size() >> 20) + " MiB; " + std::string(what) +
                                        " is far smaller (this reader stops at " + std::to_string(max_file_bytes >> 20) +
                                        " MiB)");
+    // HTH4 writes UTF-8 (hth4-files.md §1); anything else (Shift-JIS from another tool) would come
+    // out as garbled names in every file made from it.
+    for (std::size_t i = 0; i < text.size();) {
+      const auto c = static_cast<unsigned char>(text[i]);
+      const std::size_t n = c < 0x80 ? 1 : (c >> 5) == 6 ? 2 : (c >> 4) == 14 ? 3 : (c >> 3) == 30 ? 4 : 0;
+      bool ok = n != 0 && i + n <= text.size();
+      for (std::size_t k = 1; ok && k < n; ++k) ok = (static_cast<unsigned char>(text[i + k]) >> 6) == 2;
+      if (!ok)
+        throw profile_error(at(i),
+                            "not UTF-8 (byte " + std::to_string(i) +
+                                "): HeartToHeart4 writes its files in UTF-8; convert it (iconv -f SHIFT_JIS -t UTF-8)");
+      i += n;
+    }
     const auto r = doc_.load_buffer(text.data(), text.size(), pugi::parse_default, pugi::encoding_utf8);
     if (!r) throw profile_error(at(static_cast<std::size_t>(r.offset)), std::string("not XML: ") + r.description());
     root_ = doc_.document_element();
@@ -42,9 +55,12 @@ class xml_in {
       b = e + 1;
     }
     if (!known)
-      throw profile_error(where(root_), std::string("the root element is <") + root_.name() + ">, not <" +
-                                            std::string(roots.substr(0, roots.find('|'))) + ">: not " +
-                                            std::string(what));
+      throw profile_error(
+          where(root_), std::string("the root element is <") + root_.name() + ">, not <" + [&] {
+            std::string names(roots);
+            for (std::size_t k; (k = names.find('|')) != std::string::npos;) names.replace(k, 1, "> or <");
+            return names;
+          }() + ">: not " + std::string(what));
   }
   /** The root element. */
   pugi::xml_node root() const { return root_; }

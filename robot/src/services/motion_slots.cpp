@@ -418,7 +418,7 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
                     fmt::format("FILE: {} holds {} bytes; a slot takes 1..{}", src.name, b.size(), where.size));
     code = mo::disassemble(b, where);
     if (b[0] != 0xFF && !code.problems.empty())
-      throw refused(refusal_kind::usage, fmt::format("FILE: {} is not motion code for 0x{:06X}: {}", src.name,
+      throw refused(refusal_kind::usage, fmt::format("{} is not motion code for 0x{:06X}: {}", src.name,
                                                      where.address.value(), code.problems.front()));
     r.summary = b[0] == 0xFF ? "an empty slot" : fmt::format("{} reachable frames", code.code.size());
     r.bytes = b;

@@ -1,6 +1,7 @@
 // rcb4 — robot services: HTH4 projects on the board (see rcb4/robot/services/project.hpp).
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/ops/memory.hpp>
+#include <rcb4/ops/motion.hpp>
 #include <rcb4/ops/system.hpp>
 #include <rcb4/robot/services/project.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
@@ -26,7 +27,18 @@ project_import_report import_project(link& l, const rom_layout& layout, const mo
   } catch (const profile_error& e) {
     throw refused(refusal_kind::usage, std::string(e.what()) + " (nothing written)");
   }
-  if (opt.dry_run) return r;
+  if (opt.dry_run) {
+    // Say now what the real import will refuse (restore_rom's rule), rather than after the read.
+    const auto st = run(l, ops::read_motion_state{});
+    if (st.running || st.suspended)
+      r.plan.not_written.insert(
+          r.plan.not_written.begin(),
+          std::string("NOTHING yet: ") +
+              (st.motion ? "motion " + std::to_string(*st.motion) : std::string("the program")) +
+              (st.running ? " is running" : " is stopped part way") +
+              ", and the import is refused until it ends (rcb4 motion wait) or the program starts afresh");
+    return r;
+  }
   try {
     r.written = restore_rom(l, r.plan.image, save, false);
   } catch (refused& e) {
@@ -78,9 +90,12 @@ hth4::export_result export_project(link& l, const rom_layout& layout, const mode
   std::tm tm{};
   localtime_r(&now, &tm);
   char date[40];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S.0000000", &tm);
+  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S.0000000%z", &tm);
+  std::string stamp(date);  // ISO 8601's offset has a colon: +0100 -> +01:00 (as HTH4 writes it, §2.2)
+  if (stamp.size() > 4 && (stamp[stamp.size() - 5] == '+' || stamp[stamp.size() - 5] == '-'))
+    stamp.insert(stamp.size() - 2, ":");
   try {
-    return hth4::project_from_rom(rom, layout, names, slots, date);
+    return hth4::project_from_rom(rom, layout, names, slots, stamp);
   } catch (const profile_error& e) {
     throw refused(refusal_kind::board, std::string("the board's ROM does not make a project: ") + e.what());
   }

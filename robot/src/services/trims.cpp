@@ -101,6 +101,12 @@ ics_trims_report set_ics_trims(link& l, const std::vector<std::pair<unsigned, st
       throw refused(refusal_kind::usage, fmt::format("ICS {} does not exist (0..35; nothing written)", ics));
     if (std::find(seen.begin(), seen.end(), ics) != seen.end())
       throw refused(refusal_kind::usage, fmt::format("ICS {} is given twice (nothing written)", ics));
+    if (counts < -4000 || counts > 4000)
+      throw refused(
+          refusal_kind::limit,
+          fmt::format("ICS {}: a trim of {:+d} counts ({:+.1f} deg) is beyond a servo's travel (+-4000 counts, "
+                      "135 deg; nothing written)",
+                      ics, counts, counts * 135.0 / 4000.0));
     seen.push_back(ics);
   }
   const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 72));
