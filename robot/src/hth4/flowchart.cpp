@@ -70,7 +70,7 @@ flow_block read_block(const xml_in& x, const pugi::xml_node& a, bool old_schema,
 }
 
 std::uint32_t target_of(const std::vector<std::uint8_t>& f) {
-  return f[2] | (f[3] << 8) | (static_cast<std::uint32_t>(f[4]) << 16);
+  return static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
 }
 bool is_branch(const std::vector<std::uint8_t>& f) {
   return f.size() == 7 && (f[1] == jump::command_code || f[1] == call::command_code);

@@ -287,7 +287,8 @@ export_result project_from_rom(std::span<const std::uint8_t> rom, const rom_layo
   }
   // The start-up motion: the CALL at 0x0444.
   if (rom[startup_at] == 0x07 && rom[startup_at + 1] == call::command_code) {
-    const std::uint32_t t = rom[startup_at + 2] | (rom[startup_at + 3] << 8) | (rom[startup_at + 4] << 16);
+    const auto t =
+        static_cast<std::uint32_t>(rom[startup_at + 2] | (rom[startup_at + 3] << 8) | (rom[startup_at + 4] << 16));
     const std::uint32_t end = base + slots * layout.slot_size;  // 2.2's DefaultStartup, a RETURN
     const bool used_start = t >= base && t < end && (t - base) % layout.slot_size == 0 &&
                             !p.motions[(t - base) / layout.slot_size].frames.empty();

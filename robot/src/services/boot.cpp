@@ -23,7 +23,7 @@ startup_info read_startup(link& l, const rom_layout& layout) {
   startup_info s;
   s.has_call = b[0] == 0x07 && b[1] == call::command_code && checksum_ok(b);
   if (!s.has_call) return s;
-  s.target = b[2] | (b[3] << 8) | (static_cast<std::uint32_t>(b[4]) << 16);
+  s.target = static_cast<std::uint32_t>(b[2] | (b[3] << 8)) | (static_cast<std::uint32_t>(b[4]) << 16);
   const auto base = layout.motion_base.value();
   if (s.target >= base && s.target < base + layout.motion_count * layout.slot_size &&
       (s.target - base) % layout.slot_size == 0)
