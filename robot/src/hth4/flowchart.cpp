@@ -61,9 +61,18 @@ flow_block read_block(const xml_in& x, const pugi::xml_node& a, bool old_schema,
   }
   for (auto f = x.need(a, "ProgramCode").child("anyType"); f; f = f.next_sibling("anyType")) {
     auto bytes = parse_frame_text(f.child_value());
-    if (!bytes) x.fail(f, "'" + std::string(f.child_value()).substr(0, 60) + "' is not a frame (hex byte pairs)");
-    if (bytes->size() < min_frame_size || (*bytes)[0] != bytes->size() || !checksum_ok(*bytes))
-      x.fail(f, "'" + frame_text(*bytes) + "': its SIZE byte or SUM does not match the frame");
+    // (Messages built with +=: GCC 12 -O3 warns falsely about "'" + a temporary string, -Wrestrict.)
+    std::string what = "'";
+    if (!bytes) {
+      what += std::string(f.child_value()).substr(0, 60);
+      what += "' is not a frame (hex byte pairs)";
+      x.fail(f, what);
+    }
+    if (bytes->size() < min_frame_size || (*bytes)[0] != bytes->size() || !checksum_ok(*bytes)) {
+      what += frame_text(*bytes);
+      what += "': its SIZE byte or SUM does not match the frame";
+      x.fail(f, what);
+    }
     b.code.push_back(std::move(*bytes));
   }
   return b;

@@ -105,7 +105,7 @@ class xml_in {
     long long v = 0;
     const auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
     if (t.empty() || ec != std::errc{} || p != t.data() + t.size())
-      fail(c, "'" + std::string(t.substr(0, 40)) + "' is not an integer");
+      fail(c, std::string("'").append(t.substr(0, 40)).append("' is not an integer"));  // (+ warns falsely: GCC 12 -O3)
     if (v < lo || v > hi)
       fail(c, std::to_string(v) + " is out of range (" + std::to_string(lo) + ".." + std::to_string(hi) + ")");
     return v;

@@ -92,8 +92,8 @@ hth4::export_result export_project(link& l, const rom_layout& layout, const mode
   char date[40];
   std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S.0000000%z", &tm);
   std::string stamp(date);  // ISO 8601's offset has a colon: +0100 -> +01:00 (as HTH4 writes it, §2.2)
-  if (stamp.size() > 4 && (stamp[stamp.size() - 5] == '+' || stamp[stamp.size() - 5] == '-'))
-    stamp.insert(stamp.size() - 2, ":");
+  if (const auto n = stamp.size(); n > 4 && (stamp[n - 5] == '+' || stamp[n - 5] == '-'))
+    stamp = fmt::format("{}:{}", std::string_view(stamp).substr(0, n - 2), std::string_view(stamp).substr(n - 2));
   try {
     return hth4::project_from_rom(rom, layout, names, slots, stamp);
   } catch (const profile_error& e) {
