@@ -195,7 +195,8 @@ motion_step parse_step(const std::string& source, const YAML::Node& n, const mod
         b.value =
             static_cast<std::uint16_t>(integer(source, c, std::string(compares[i]), 0, b.size == 1 ? 0xFF : 0xFFFF));
       }
-    if (given != 1) fail(source, n, "if_ram: one of equal, not_equal, below, at_least, at_most gives the value to compare with");
+    if (given != 1)
+      fail(source, n, "if_ram: one of equal, not_equal, below, at_least, at_most gives the value to compare with");
     b.to = label_name(source, n["goto"], "goto");
     return b;
   }

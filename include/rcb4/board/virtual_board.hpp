@@ -129,8 +129,7 @@ class virtual_board {
     // HTH4 2.x's boot ends in StartupCmd, a CALL of the start-up motion just before the main loop
     // (hth4-files.md §3): run from there when the ROM has one, else from the main loop.
     const auto at = hth4_2_2.startup.value();
-    const bool startup = mem_.rom[at] == 0x07 && mem_.rom[at + 1] == call::command_code &&
-                         checksum_ok(std::span<const std::uint8_t>(mem_.rom).subspan(at, 7));
+    const bool startup = call_target(std::span<const std::uint8_t>(mem_.rom).subspan(at)).has_value();
     mem_.set_pc(startup ? at : hth4_2_2.main_loop.value());
     mem_.put16(ram::pio_direction.value(), 0x03FF);
     for (unsigned k = 0; k < ram::timers; ++k) mem_.put16(ram::timer.value() + 2 * k, ram::timer_stopped);

@@ -141,6 +141,18 @@ struct call : detail::branch<0x0C> {
   }
 };
 
+/**
+ * The target of the CALL frame @p bytes start with (SIZE 7, SUM and COND checked), or nothing:
+ * how HTH4's StartupCmd at 0x0444 is told and read (hth4-files.md §3).
+ */
+constexpr std::optional<std::uint32_t> call_target(std::span<const std::uint8_t> bytes) noexcept {
+  if (bytes.size() < 7 || bytes[0] != 7 || bytes[1] != call::command_code || !checksum_ok(bytes.first(7)))
+    return std::nullopt;
+  const auto c = call::parse(bytes.first(7), codec_options{});
+  if (!c) return std::nullopt;
+  return c->target().value();
+}
+
 /** RETURN: pop the return address; without a pending CALL the board stops the program. */
 struct ret {
   static constexpr std::uint8_t command_code = 0x0D;  ///< CMD byte

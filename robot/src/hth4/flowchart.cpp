@@ -1,5 +1,6 @@
 // rcb4 — HTH4 motion flowcharts (see rcb4/robot/hth4/flowchart.hpp; hth4-files.md §5).
 // SPDX-License-Identifier: BSL-1.0
+#include "project_check.hpp"
 #include "xml.hpp"
 
 #include <rcb4/frame.hpp>
@@ -78,18 +79,6 @@ flow_block read_block(const xml_in& x, const pugi::xml_node& a, bool old_schema,
   return b;
 }
 
-std::uint32_t target_of(const std::vector<std::uint8_t>& f) {
-  return static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
-}
-bool is_branch(const std::vector<std::uint8_t>& f) {
-  return f.size() == 7 && (f[1] == jump::command_code || f[1] == call::command_code);
-}
-void set_target(std::vector<std::uint8_t>& f, std::uint32_t t) {
-  f[2] = static_cast<std::uint8_t>(t);
-  f[3] = static_cast<std::uint8_t>(t >> 8);
-  f[4] = static_cast<std::uint8_t>(t >> 16);
-  f[6] = checksum(std::span<const std::uint8_t>(f).first(6));
-}
 constexpr std::uint32_t placeholder = 0xFFFFFF;
 
 }  // namespace
@@ -207,7 +196,7 @@ compiled_flowchart compile_flowchart(const flowchart& f, std::uint32_t address, 
   };
   const auto jump_to = [&](std::uint32_t t) {
     std::vector<std::uint8_t> j{0x07, jump::command_code, 0, 0, 0, 0x00, 0};
-    set_target(j, t);
+    set_branch_target(j, t);
     emit(std::move(j));
   };
   const std::uint32_t base = layout.motion_base.value(), end = base + layout.motion_count * layout.slot_size;
@@ -225,20 +214,21 @@ compiled_flowchart compile_flowchart(const flowchart& f, std::uint32_t address, 
       for (std::size_t k = 0; k < blk.code.size(); ++k) {
         auto frame = blk.code[k];
         if (is_branch(frame)) {
-          const auto t = target_of(frame);
+          const auto t = branch_target(frame);
           if (t == placeholder) {
             if (!next[b].on_true) fail(&blk, "its JUMP waits for a True line, and none leaves it");
             has_placeholder = true;
             fixups.push_back({out.frames.size(), *next[b].on_true});
           } else if (blk.base_name == "Wait" && frame[1] == jump::command_code && k > 0) {
-            set_target(frame, *placed[b] + static_cast<std::uint32_t>(blk.code[0].size()));  // back to its SUB (§5.4)
+            set_branch_target(frame,
+                              *placed[b] + static_cast<std::uint32_t>(blk.code[0].size()));  // back to its SUB (§5.4)
           } else if (!slot_start(t, base) && t != end) {
             if (!slot_start(t, other)) fail(&blk, motion::hex_address(t) + " is not the start of a motion slot");
             const auto moved = t - other + base;
             out.notes.push_back("block '" + blk.name + "': its " + (frame[1] == call::command_code ? "CALL" : "JUMP") +
                                 " to " + motion::hex_address(t) + " moved to " + motion::hex_address(moved) +
                                 " (the other 2.x layout's slot)");
-            set_target(frame, moved);
+            set_branch_target(frame, moved);
           }
         }
         emit(std::move(frame));
@@ -268,7 +258,7 @@ compiled_flowchart compile_flowchart(const flowchart& f, std::uint32_t address, 
       jump_to(*placed[t]);
   }
   emit({0x03, 0x0D, 0x10, 0xFF});
-  for (const auto& [frame, target] : fixups) set_target(out.frames[frame], *placed[target]);  // step 4
+  for (const auto& [frame, target] : fixups) set_branch_target(out.frames[frame], *placed[target]);  // step 4
   if (at - address > layout.slot_size)
     fail(nullptr, "compiles to " + std::to_string(at - address) + " bytes, more than a " +
                       std::to_string(layout.slot_size) + "-byte slot");

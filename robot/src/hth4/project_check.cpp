@@ -81,14 +81,9 @@ std::vector<std::vector<std::uint8_t>> relocate(const std::vector<std::vector<st
   auto out = frames;
   const std::uint32_t end = from_base + static_cast<std::uint32_t>(motion_count) * hth4_2_2.slot_size;
   for (auto& f : out) {
-    if (f.size() != 7 || f[0] != 7 || (f[1] != jump::command_code && f[1] != call::command_code)) continue;
-    const std::uint32_t t = static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
-    if (t < from_base || t >= end) continue;
-    const std::uint32_t moved = t - from_base + to_base;
-    f[2] = static_cast<std::uint8_t>(moved);
-    f[3] = static_cast<std::uint8_t>(moved >> 8);
-    f[4] = static_cast<std::uint8_t>(moved >> 16);
-    f[6] = checksum(std::span<const std::uint8_t>(f).first(6));
+    if (!is_branch(f)) continue;
+    const std::uint32_t t = branch_target(f);
+    if (t >= from_base && t < end) set_branch_target(f, t - from_base + to_base);
   }
   return out;
 }
@@ -161,8 +156,8 @@ void check_project(const project& p, const where_fn& where) {
   for (std::size_t i = 0; i < motion_count; ++i)
     for (std::size_t j = 0; j + 1 < p.motions[i].frames.size(); ++j) {
       const auto& f = p.motions[i].frames[j];
-      if (f[1] != jump::command_code && f[1] != call::command_code) continue;
-      const std::uint32_t t = static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
+      if (!is_branch(f)) continue;
+      const std::uint32_t t = branch_target(f);
       if (const auto why = target_ok(i, t); !why.empty())
         throw profile_error(where({place::in_frame, static_cast<unsigned>(i), static_cast<unsigned>(j)}),
                             std::string(f[1] == jump::command_code ? "JUMP" : "CALL") + " to " + hex(t) + ": " + why);
@@ -174,8 +169,8 @@ void check_project(const project& p, const where_fn& where) {
   for (std::size_t i = 0; i < motion_count; ++i)
     for (std::size_t j = 0; j + 1 < p.motions[i].frames.size(); ++j) {
       const auto& f = p.motions[i].frames[j];
-      if (f.size() != 7 || (f[1] != jump::command_code && f[1] != call::command_code)) continue;
-      const std::uint32_t t = static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
+      if (!is_branch(f)) continue;
+      const std::uint32_t t = branch_target(f);
       const std::size_t s = (t - base) / slot;
       if (s != i || f[1] == call::command_code) {
         callees[i].push_back(s);

@@ -5,9 +5,29 @@
 
 #include <rcb4/robot/hth4/project.hpp>
 
+#include <rcb4/commands/flow.hpp>
+#include <rcb4/frame.hpp>
+
 #include <functional>
+#include <span>
 
 namespace rcb4::robot::hth4 {
+
+/** True for a 7-byte JUMP or CALL frame as HTH4 keeps them (protocol.md §4.3: [07][0B|0C][a0][a1][a2][COND][SUM]). */
+inline bool is_branch(std::span<const std::uint8_t> f) {
+  return f.size() == 7 && f[0] == 7 && (f[1] == jump::command_code || f[1] == call::command_code);
+}
+/** The 24-bit target of a JUMP or CALL frame, low byte first (FF FF FF: HTH4's placeholder, §5.4). */
+inline std::uint32_t branch_target(std::span<const std::uint8_t> f) {
+  return static_cast<std::uint32_t>(f[2] | (f[3] << 8)) | (static_cast<std::uint32_t>(f[4]) << 16);
+}
+/** Points the JUMP or CALL frame @p f at @p t and makes its SUM again. */
+inline void set_branch_target(std::span<std::uint8_t> f, std::uint32_t t) {
+  f[2] = static_cast<std::uint8_t>(t);
+  f[3] = static_cast<std::uint8_t>(t >> 8);
+  f[4] = static_cast<std::uint8_t>(t >> 16);
+  f[6] = checksum(f.first(6));
+}
 
 /** Where in a project a check failed. */
 struct place {

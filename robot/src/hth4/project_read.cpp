@@ -24,6 +24,19 @@ std::vector<std::uint8_t> bytes_of(const xml_in& x, const pugi::xml_node& n, con
   return out;
 }
 
+/** The value child @p element of @p n names among @p names, else an error "'X' is not WHAT (A, B)". */
+template <class E>
+E named(const xml_in& x, const pugi::xml_node& n, const char* element,
+        std::initializer_list<std::pair<std::string_view, E>> names, const char* what) {
+  const auto e = x.need(n, element);
+  std::string list;
+  for (const auto& [name, value] : names) {
+    if (name == e.child_value()) return value;
+    list += (list.empty() ? "" : ", ") + std::string(name);
+  }
+  x.fail(e, std::string("'").append(e.child_value()).append("' is not ").append(what).append(" (" + list + ")"));
+}
+
 compare_type compare_of(const xml_in& x, const pugi::xml_node& n) {
   const auto e = x.need(n, "CompareType");
   const auto c = compare_from(e.child_value());
@@ -95,20 +108,9 @@ servo_entry read_servo(const xml_in& x, const pugi::xml_node& entry) {
   s.count = static_cast<unsigned>(x.integer(v, "Count", 0, 255));
   s.rom_address = static_cast<std::uint32_t>(x.integer(v, "RomAddress", 0, 0x3FFFF));
   s.ram_address = static_cast<std::uint32_t>(x.integer(v, "RamAddress", 0, 0xFFFF));
-  const auto mode = x.need(v, "Mode");
-  if (std::string_view(mode.child_value()) == "Normal")
-    s.mode = servo_mode::normal;
-  else if (std::string_view(mode.child_value()) == "None")
-    s.mode = servo_mode::none;
-  else
-    x.fail(mode, "'" + std::string(mode.child_value()) + "' is not a servo mode (Normal, None)");
-  const auto port = x.need(v, "Port");
-  if (std::string_view(port.child_value()) == "SIO1")
-    s.port = servo_port::sio1;
-  else if (std::string_view(port.child_value()) == "SIO2")
-    s.port = servo_port::sio2;
-  else
-    x.fail(port, "'" + std::string(port.child_value()) + "' is not a servo port (SIO1, SIO2)");
+  s.mode =
+      named<servo_mode>(x, v, "Mode", {{"Normal", servo_mode::normal}, {"None", servo_mode::none}}, "a servo mode");
+  s.port = named<servo_port>(x, v, "Port", {{"SIO1", servo_port::sio1}, {"SIO2", servo_port::sio2}}, "a servo port");
   s.device_number = static_cast<unsigned>(x.integer(v, "DeviceNumber", 0, 35));
   s.code = static_cast<unsigned>(x.integer(v, "Code", 0, 255));
   s.id = static_cast<unsigned>(x.integer(v, "ID", 0, 31));

@@ -10,7 +10,7 @@ namespace rcb4::robot::hth4 {
 namespace {
 
 using detail::add;
-using detail::add_key;
+using detail::add_entry;
 using detail::add_raw;
 
 void add_bytes(pugi::xml_node n, const char* name, std::span<const std::uint8_t> bytes) {
@@ -19,12 +19,9 @@ void add_bytes(pugi::xml_node n, const char* name, std::span<const std::uint8_t>
 }
 
 void add_motion(pugi::xml_node coll, const motion_entry& m) {
-  auto e = coll.append_child("DictionaryEntry");
   char key[8];
   std::snprintf(key, sizeof key, "M%03u", (m.number + 1) % 1000);
-  add_key(e, key);
-  auto v = e.append_child("Value");
-  v.append_attribute("xsi:type") = "Motion";
+  auto v = add_entry(coll, key, "Motion");
   add(v, "Number", m.number);
   add(v, "Name", m.name);
   add(v, "Date", m.date);
@@ -40,10 +37,7 @@ void add_motion(pugi::xml_node coll, const motion_entry& m) {
 }
 
 void add_servo(pugi::xml_node coll, const servo_entry& s) {
-  auto e = coll.append_child("DictionaryEntry");
-  add_key(e, s.name);
-  auto v = e.append_child("Value");
-  v.append_attribute("xsi:type") = "ServoItem";
+  auto v = add_entry(coll, s.name, "ServoItem");
   add(v, "Name", s.name);
   add(v, "Count", s.count);
   add(v, "RomAddress", s.rom_address);
@@ -88,11 +82,8 @@ void add_kri3(pugi::xml_node r, const kri3_block& k) {
 }
 
 void add_priority(pugi::xml_node coll, const priority_entry& p) {
-  auto e = coll.append_child("DictionaryEntry");
-  add_key(e, p.key, p.key_type.c_str());
+  auto v = add_entry(coll, p.key, p.value ? "PriorityMotion" : nullptr, p.key_type.c_str());
   if (!p.value) return;
-  auto v = e.append_child("Value");
-  v.append_attribute("xsi:type") = "PriorityMotion";
   add(v, "Name", p.value->name);
   add(v, "Port", p.value->port);
   add(v, "CompareType", compare_name(p.value->compare));

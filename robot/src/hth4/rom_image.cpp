@@ -35,19 +35,6 @@ std::uint16_t word_at(std::span<const std::uint8_t> b, std::uint32_t at) {
   return static_cast<std::uint16_t>(b[at] | (b[at + 1] << 8));
 }
 
-/** The CALL HTH4's start-up frame makes (0x0444, hth4-files.md §3): 07 0C a0 a1 a2 00 SUM. */
-std::array<std::uint8_t, 7> startup_call(std::uint32_t target) {
-  std::array<std::uint8_t, 7> f{0x07,
-                                call::command_code,
-                                static_cast<std::uint8_t>(target),
-                                static_cast<std::uint8_t>(target >> 8),
-                                static_cast<std::uint8_t>(target >> 16),
-                                0x00,
-                                0};
-  f[6] = checksum(std::span<const std::uint8_t>(f).first(6));
-  return f;
-}
-
 }  // namespace
 
 import_plan plan_import(std::span<const std::uint8_t> rom, const project& p, const import_options& opt) {
@@ -180,12 +167,12 @@ import_plan plan_import(std::span<const std::uint8_t> rom, const project& p, con
   put(plan, "AD references", adc_at, adc);
   // 5. The start-up motion (§3: the CALL at 0x0444).
   if (p.startup_address >= 0) {
-    if (rom[startup_at] != 0x07 || rom[startup_at + 1] != call::command_code)
+    if (!call_target(rom.subspan(startup_at)))
       plan.not_written.push_back("the start-up motion: the board has no CALL at 0x000444 (not HTH4 2.x boot code)");
     else {
       const auto target = moved(static_cast<std::uint32_t>(p.startup_address));
-      const auto f = startup_call(target);
-      put(plan, "start-up motion " + hex(target), startup_at, f);
+      const auto f = encode(call{rom_address::make(target).value()});  // 07 0C a0 a1 a2 00 SUM (§3)
+      put(plan, "start-up motion " + hex(target), startup_at, f.bytes());
     }
   }
   // 6. What is not written (§10.6).
@@ -286,9 +273,8 @@ export_result project_from_rom(std::span<const std::uint8_t> rom, const rom_layo
     m->buttons = *b;
   }
   // The start-up motion: the CALL at 0x0444.
-  if (rom[startup_at] == 0x07 && rom[startup_at + 1] == call::command_code) {
-    const auto t =
-        static_cast<std::uint32_t>(rom[startup_at + 2] | (rom[startup_at + 3] << 8) | (rom[startup_at + 4] << 16));
+  if (const auto startup = call_target(rom.subspan(startup_at))) {
+    const std::uint32_t t = *startup;
     const std::uint32_t end = base + slots * layout.slot_size;  // 2.2's DefaultStartup, a RETURN
     const bool used_start = t >= base && t < end && (t - base) % layout.slot_size == 0 &&
                             !p.motions[(t - base) / layout.slot_size].frames.empty();

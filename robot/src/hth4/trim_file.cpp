@@ -39,10 +39,7 @@ std::string trim_file_xml(const std::vector<trim_entry>& entries) {
   pugi::xml_document doc;
   auto r = detail::new_root(doc, "ArrayOfDictionaryEntry");
   for (const auto& t : entries) {
-    auto e = r.append_child("DictionaryEntry");
-    detail::add_key(e, t.name);
-    auto v = e.append_child("Value");
-    v.append_attribute("xsi:type") = "PositionData";
+    auto v = detail::add_entry(r, t.name, "PositionData");
     detail::add(v, "Name", t.name);
     detail::add(v, "ID", t.id);
     detail::add(v, "DeviceNumber", t.device_number);

@@ -156,10 +156,18 @@ inline pugi::xml_node add(pugi::xml_node n, const char* name, std::string_view t
 }
 /** Appends <name>number</name>. */
 inline pugi::xml_node add(pugi::xml_node n, const char* name, long long v) { return add(n, name, std::to_string(v)); }
-/** Appends <Key xsi:type="…">key</Key> to a DictionaryEntry. */
-inline void add_key(pugi::xml_node entry, std::string_view key, const char* type = "xsd:string") {
-  auto k = add(entry, "Key", key);
-  k.prepend_attribute("xsi:type") = type;
+/**
+ * Appends <DictionaryEntry><Key xsi:type="@p key_type">key</Key><Value xsi:type="@p value_type">
+ * to @p coll and returns the Value (§1); no Value, and a null node, when @p value_type is null.
+ */
+inline pugi::xml_node add_entry(pugi::xml_node coll, std::string_view key, const char* value_type,
+                                const char* key_type = "xsd:string") {
+  auto e = coll.append_child("DictionaryEntry");
+  add(e, "Key", key).prepend_attribute("xsi:type") = key_type;
+  if (!value_type) return {};
+  auto v = e.append_child("Value");
+  v.append_attribute("xsi:type") = value_type;
+  return v;
 }
 /** Appends the elements in @p raw (kept from a read) to @p n. */
 inline void add_raw(pugi::xml_node n, const std::string& raw) {

@@ -21,9 +21,10 @@ std::uint32_t default_startup(const rom_layout& layout) {
 startup_info read_startup(link& l, const rom_layout& layout) {
   const auto b = run(l, rcb4::ops::read_memory(memory::rom, layout.startup.value(), 7));
   startup_info s;
-  s.has_call = b[0] == 0x07 && b[1] == call::command_code && checksum_ok(b);
+  const auto target = call_target(b);
+  s.has_call = target.has_value();
   if (!s.has_call) return s;
-  s.target = static_cast<std::uint32_t>(b[2] | (b[3] << 8)) | (static_cast<std::uint32_t>(b[4]) << 16);
+  s.target = *target;
   const auto base = layout.motion_base.value();
   if (s.target >= base && s.target < base + layout.motion_count * layout.slot_size &&
       (s.target - base) % layout.slot_size == 0)
@@ -51,15 +52,8 @@ startup_info set_startup(link& l, const rom_layout& layout, std::optional<unsign
           refusal_kind::usage,
           fmt::format("where DefaultStartup is in the {} layout is not known: give a motion instead", layout.name));
   }
-  std::array<std::uint8_t, 7> f{0x07,
-                                call::command_code,
-                                static_cast<std::uint8_t>(target),
-                                static_cast<std::uint8_t>(target >> 8),
-                                static_cast<std::uint8_t>(target >> 16),
-                                0x00,
-                                0};
-  f[6] = checksum(std::span<const std::uint8_t>(f).first(6));
-  run(l, rcb4::ops::write_memory(memory::rom, layout.startup.value(), f));
+  const auto f = encode(call{rom_address::make(target).value()});  // 07 0C a0 a1 a2 00 SUM
+  run(l, rcb4::ops::write_memory(memory::rom, layout.startup.value(), f.bytes()));
   const auto back = read_startup(l, layout);
   if (back.target != target)
     throw refused(refusal_kind::board,

@@ -40,7 +40,7 @@ project_import_report import_project(link& l, const rom_layout& layout, const mo
     return r;
   }
   try {
-    r.written = restore_rom(l, r.plan.image, save, false);
+    r.written = restore_rom(l, r.plan.image, save, false, rom);  // the ROM read above: not read twice
   } catch (refused& e) {
     if (e.hint.ends_with("then restore")) e.hint.replace(e.hint.size() - 7, 7, "import");
     throw;

@@ -108,7 +108,8 @@ std::string implausible_rom(std::span<const std::uint8_t> image) {
   return {};
 }
 
-restore_report restore_rom(link& l, std::span<const std::uint8_t> image, const rom_sink& save, bool force) {
+restore_report restore_rom(link& l, std::span<const std::uint8_t> image, const rom_sink& save, bool force,
+                           std::span<const std::uint8_t> known) {
   if (image.size() != rom_size)
     throw refused(refusal_kind::usage,
                   fmt::format("the image holds {} bytes; a ROM image is {}", image.size(), rom_size));
@@ -133,7 +134,8 @@ restore_report restore_rom(link& l, std::span<const std::uint8_t> image, const r
                               st.motion ? fmt::format("motion {}", *st.motion) : std::string("the board's program")),
                   "rcb4 motion play N (any motion) starts the program afresh; then restore");
   restore_report r;
-  const auto now = backup_rom(l, "reading ROM (the backup of what is replaced)");
+  const auto now = known.size() == rom_size ? std::vector<std::uint8_t>(known.begin(), known.end())
+                                            : backup_rom(l, "reading ROM (the backup of what is replaced)");
   std::vector<std::size_t> differ;
   for (std::size_t at = 0; at < image.size(); at += rom_piece)
     if (!std::equal(image.begin() + static_cast<std::ptrdiff_t>(at),

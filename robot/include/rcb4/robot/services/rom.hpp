@@ -65,7 +65,10 @@ struct restore_report {
  * rom_size bytes, is implausible (unless @p force), or a motion runs or is stopped part way; the
  * ROM it replaces goes to @p save first; each piece is read back; the button table the board
  * compares (RAM) is then loaded from the new ROM, so what `buttons` lists is what a press does.
+ * @p now: the board's ROM as the caller has just read it (rom_size bytes), not read again; empty:
+ * read here.
  */
-restore_report restore_rom(link& l, std::span<const std::uint8_t> image, const rom_sink& save, bool force);
+restore_report restore_rom(link& l, std::span<const std::uint8_t> image, const rom_sink& save, bool force,
+                           std::span<const std::uint8_t> now = {});
 
 }  // namespace rcb4::robot::services
