@@ -18,6 +18,7 @@ packages=(
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
+  eslint                               # the page's JavaScript linted in the suite (lint.studio_js)
   libjs-three                          # three.js r111 (with OrbitControls): rcb4 ui draws the robot in 3D (embedded at build time)
   liburdfdom-tools                     # check_urdf: the suite checks that `rcb4 urdf` parses
   pybind11-dev python3-dev python3-pytest python3-numpy python3-serial  # pyrcb4, its tests, its benchmark

@@ -118,6 +118,21 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         doc = js(driver, "return window.rcb4Studio.editor.doc")
         knees = [s["pose"]["left_knee"] for s in doc["steps"][:3]]
         check(knees == [30, -20, 10], f"Alt+↓ (the keyboard) moves it back ({knees})")
+        # Dragged: the first pose dropped on the third. WebDriver cannot drag HTML5 draggables in
+        # headless Chromium, so the browser's drag events are dispatched to the page's handlers
+        # as a drag delivers them (dragstart on the source, dragover and drop on the target).
+        drag = """const [from, to] = arguments, dt = new DataTransfer();
+                  const at = (i) => document.querySelector(`#ed-steps li[data-step="${i}"]`);
+                  at(from).dispatchEvent(new DragEvent('dragstart', { dataTransfer: dt, bubbles: true }));
+                  const target = at(to);
+                  target.dispatchEvent(new DragEvent('dragover', { dataTransfer: dt, bubbles: true, cancelable: true }));
+                  target.dispatchEvent(new DragEvent('drop', { dataTransfer: dt, bubbles: true, cancelable: true }));"""
+        js(driver, drag, 0, 2)
+        knees = [s["pose"]["left_knee"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
+        check(knees == [-20, 10, 30], f"the first pose dragged onto the third ({knees})")
+        js(driver, drag, 2, 0)
+        knees = [s["pose"]["left_knee"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
+        check(knees == [30, -20, 10], f"and dragged back ({knees})")
         # Retime the second pose.
         click(driver, "css", '#ed-steps li[data-step="1"]')
         js(driver, "const t = document.querySelector('#ed-time'); t.value = 400; t.dispatchEvent(new Event('change'))")
@@ -144,6 +159,30 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
               f"at the authored timing: 1.4 s of poses shown in 1.4 s ({shown!r})")
         check(abs((measured(driver, "left_knee") or 0) + 20) < 1, "a preview does not move the robot")
         shot(driver, "rcb4-studio.png")
+
+        # Played on the robot from the host at its timing: it ends at the last pose.
+        js(driver, "document.querySelector('#message').textContent = ''")
+        click(driver, "id", "ed-play")
+        said = wait_until(lambda: "played" in message(driver) and message(driver), timeout=15)
+        check(said and abs((measured(driver, "left_knee") or 0) - 10) < 1 and abs((measured(driver, "head_yaw") or 0) - 15) < 1,
+              f"Play on robot ends at the last pose ({said!r}, knee {measured(driver, 'left_knee')})")
+        # Stop while the robot is still on its way into the first pose: it holds there and the
+        # motion is not played after all (nothing the user did not ask for).
+        slide(driver, "left_knee", -40)
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 40) < 0.6, timeout=10)
+        js(driver, "document.querySelector('#message').textContent = ''")
+        # Play, and Stop 0.2 s later (clicked by the page's script: WebDriver's clicks take longer
+        # than the 0.8 s the move from -40° to the first pose's 30° takes at 90°/s).
+        js(driver, "document.querySelector('#ed-play').click(); setTimeout(() => document.querySelector('#ed-stop').click(), 200)")
+        time.sleep(0.7)
+        held = measured(driver, "left_knee") or 0
+        time.sleep(2.5)  # longer than the rest of the move and the whole motion would take
+        now = measured(driver, "left_knee") or 0
+        check(abs(now - held) < 1.5 and held < 20 and "played" not in message(driver)
+              and not (js(driver, "return window.rcb4State.motion") or {}).get("running"),
+              f"Stop during the move into the first pose: the knee holds ({held:.1f} then {now:.1f}), nothing played ({message(driver)!r})")
+        slide(driver, "left_knee", -20)
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 20) < 0.6, timeout=10)
 
         # Pushed to slot 10: the backup named.
         js(driver, "document.querySelector('#ed-slot').value = 10")

@@ -4,7 +4,7 @@
 // services): pushed to a slot with its backup named, pulled from one, played from the host at the
 // authored timing, previewed in 3D without the robot, opened from and saved to a file.
 
-import { el, $, fmtDeg } from './dom.js';
+import { el, $ } from './dom.js';
 
 const KINDS = {
   pose: () => null,  // made from the robot or the ghost
@@ -61,11 +61,11 @@ export function segments(steps, start, limitMs = 120000) {
   for (;;) {
     if (total > limitMs || quiet >= 10000) { out.endless = true; break; }  // round for ever (or spinning)
     if (pc >= steps.length) break;
-    const s = steps[pc], k = kindOf(s), at = pc;
+    const s = steps[pc], k = kindOf(s), here = pc;
     pc += 1;
     if (k === 'pose') {
       const to = { ...cur, ...s.pose };
-      out.push({ from: cur, to, ms: s.time_ms, step: at });
+      out.push({ from: cur, to, ms: s.time_ms, step: here });
       cur = to;
       total += s.time_ms;
       quiet = 0;
@@ -109,7 +109,7 @@ export function at(segs, t) {
 export function createEditor(root, ctx) {
   const h = ctx.hello;
   const limits = new Map(h.joints.map((j) => [j.name, j]));
-  const ed = { doc: { robot: h.robot, name: '', period_ms: 10, steps: ['end'] }, sel: 0, undo: [], redo: [], preview: null };
+  const ed = { doc: { robot: h.robot, name: '', period_ms: 10, steps: ['end'] }, sel: 0, undo: [], redo: [], preview: null, run: 0, playing: false };
 
   // --- the parts of the panel ---
   const name = el('input', { id: 'ed-name', placeholder: 'motion name (names its slot)', maxlength: 64, 'aria-label': 'motion name' });
@@ -165,9 +165,9 @@ export function createEditor(root, ctx) {
   // A new step goes after the selected one; with the closing end selected, before it.
   const insert = (s) => change(() => {
     const last = ed.sel === ed.doc.steps.length - 1 && kindOf(ed.doc.steps[ed.sel]) === 'end';
-    const at = last ? ed.sel : ed.sel + 1;
-    ed.doc.steps.splice(at, 0, s);
-    ed.sel = at;
+    const where = last ? ed.sel : ed.sel + 1;
+    ed.doc.steps.splice(where, 0, s);
+    ed.sel = where;
   });
   function poseAt(i) {  // the whole robot after step i: the measured angles, then every pose up to it
     const out = { ...ctx.measured() };
@@ -373,12 +373,12 @@ export function createEditor(root, ctx) {
   file.addEventListener('change', async () => {
     const f = file.files[0];
     if (!f) return;
+    file.value = '';  // the same file chosen again opens again
     try {
       const r = await ctx.request({ op: 'motion_check', text: await f.text() });
       load(r.motion);
       ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
-    file.value = '';
   });
 
   // --- preview, play, stop ---
@@ -405,18 +405,27 @@ export function createEditor(root, ctx) {
   }
   async function play() {
     stop();
+    // A Stop pressed while the robot moves into the first pose holds it there and ends this play:
+    // nothing more is sent once the run it started is no longer the current one.
+    const run = ++ed.run;
+    ed.playing = true;
     const first = ed.doc.steps.find((s) => kindOf(s) === 'pose');
     try {
       if (first) {  // into the first pose at the speed limit; from there, the authored timing
         const r = await ctx.request({ op: 'move', joints: first.pose });
         await new Promise((done) => setTimeout(done, (r.ms ?? 0) + 50));
+        if (run !== ed.run) return;
       }
       await ctx.request({ op: 'play_motion', text: text() });
-      ed.playing = true;
-      ctx.say('playing on the robot from the host');
-    } catch (e) { ctx.say(e.message, 'error'); }
+      if (run === ed.run) ctx.say('playing on the robot from the host');
+    } catch (e) {
+      if (run !== ed.run) return;
+      ed.playing = false;  // refused or failed: nothing of this play runs, nothing to stop
+      ctx.say(e.message, 'error');
+    }
   }
   function stop() {
+    ed.run += 1;
     if (ed.preview) { cancelAnimationFrame(ed.preview); ed.preview = null; cursor.hidden = true; }
     if (ed.playing && ctx.controlling()) ctx.send({ op: 'stop' });  // the play from the host, and a ROM motion it called
     ed.playing = false;

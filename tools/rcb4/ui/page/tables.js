@@ -102,10 +102,10 @@ export function createTables(root, ctx) {
   function showEntries(r) {
     if (r.done) ctx.say(r.done);
     const row = (e, where) => el('li', {}, el('span', { text: `${e.buttons ?? '(not buttons)'} → ${e.slot ? `motion ${e.slot}${e.name ? ` (${e.name})` : ''}` : '0x' + e.address.toString(16)}` }), el('span', { class: 'small muted', text: where }));
-    const list = r.entries ? r.entries.map((e) => row(e, 'RAM and ROM'))
+    const shown = r.entries ? r.entries.map((e) => row(e, 'RAM and ROM'))
       : [...r.ram.map((e) => row(e, r.same ? 'RAM and ROM' : 'RAM')), ...(r.same ? [] : r.rom.map((e) => row(e, 'ROM')))];
-    entries.replaceChildren(...list);
-    if (!list.length) entries.append(el('li', { class: 'muted', text: 'no button plays anything' }));
+    entries.replaceChildren(...shown);
+    if (!shown.length) entries.append(el('li', { class: 'muted', text: 'no button plays anything' }));
     if (r.rom_program === false) entries.append(el('li', { class: 'error', text: 'the ROM program is off: no button plays anything until it runs (Resume)' }));
   }
   const readButtons = () => ask({ op: 'buttons' }, null, showEntries);
