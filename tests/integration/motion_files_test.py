@@ -264,6 +264,24 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     check(proc.returncode == 130 and "interrupted at step" in err and time.monotonic() - sent < 1.0,
           f"Ctrl-C stops a motion played from the host within 1 s ({proc.returncode}: {err.strip()!r})")
 
+    # Ctrl-C while a called ROM motion's pose is under way: every servo holds where it is, the
+    # ones the called motion moves too (not only those the file's own poses moved).
+    write("slow.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - label: a\n  - pose: {head_yaw: 40}\n    time_ms: 900\n"
+                       "  - pose: {head_yaw: -40}\n    time_ms: 900\n  - goto: a\n")
+    run(*on, "motion", "push", "slow.yaml", "11", "--backup", "eleven.bin")
+    write("call11.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {left_knee: 5}\n    time_ms: 150\n"
+                         "  - call: 11\n  - end\n")
+    proc = subprocess.Popen([RCB4, *on, "motion", "play", "call11.yaml"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(1.2)  # inside motion 11's first pose (0.15 s, then 0.9 s towards +40)
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=10)
+    first = joints_deg(on)["head_yaw"]
+    time.sleep(0.5)
+    then = joints_deg(on)["head_yaw"]
+    check(proc.returncode == 130 and abs(first - then) < 0.5 and abs(then) < 39,
+          f"Ctrl-C inside a called motion's pose: head_yaw (moved only by the called motion) holds ({first} then {then}; {err.strip()!r})")
+    run(*on, "motion", "play", "1", "--wait", "--timeout", "5")
+
     # Ctrl-C while a file waits for a ROM motion it called (one that never ends): within 1 s, and
     # the motion stopped on the board too.
     run(*on, "motion", "push", "forever.yaml", "10", "--backup", "ten.bin")

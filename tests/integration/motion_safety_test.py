@@ -175,7 +175,14 @@ with serve("--period", "15") as dev:
     rc, out, err = run(*on, "motion", "buttons", "press", "triangle+square")
     check(rc == 1 and "no entry of the table plays anything" in err and "--hold" in err,
           f"press without --hold and no entry: refused, saying --hold ({rc}: {err.strip()!r})")
+    # An entry for the buttons held now would start its motion the moment it is written.
+    rc, out, err = run(*on, "motion", "buttons", "set", "triangle+square", "1")
+    check(rc == 1 and "are held now" in err and "release" in err and not status(on).get("running"),
+          f"buttons set of the buttons held now: refused, nothing played ({rc}: {err.strip()!r})")
     run(*on, "motion", "buttons", "release")
+    rc, out, err = run(*on, "motion", "buttons", "set", "triangle+square", "1")
+    check(rc == 0 and not status(on).get("running"), f"released, the entry is set and nothing plays ({rc}: {err.strip()!r})")
+    run(*on, "motion", "buttons", "clear", "triangle+square")
 
     # A file far larger than any motion: refused by its size, at once, nothing written.
     with open("huge.yaml", "w") as f:

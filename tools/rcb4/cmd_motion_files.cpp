@@ -245,9 +245,11 @@ int play_file(session& s, const std::string& file, bool rescale, const motion_op
     if (g.json)
       emit(json{{"played", file}, {"interrupted", true}, {"poses", play.poses()}, {"seconds", seconds()}});
     else
-      fmt::print(stderr, "interrupted at step {} after {} ({:.1f} s): the servos it moved hold where they are{}\n",
-                 play.step(), plural(play.poses(), "pose"), seconds(),
-                 play.calls() ? " (a ROM motion it called was stopped: rcb4 motion play N starts afresh)" : "");
+      fmt::print(stderr, "interrupted at step {} after {} ({:.1f} s): {}\n", play.step(), plural(play.poses(), "pose"),
+                 seconds(),
+                 play.calls() ? "every servo holds where it is (a ROM motion it called was stopped: rcb4 motion play N "
+                                "starts afresh)"
+                              : "the servos it moved hold where they are");
     return exit_interrupted;
   }
   if (g.json)

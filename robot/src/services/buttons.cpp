@@ -103,6 +103,15 @@ std::vector<vector_entry> editable(const button_tables& t) {
 table_report set_button(link& l, const rom_layout& layout, std::uint16_t buttons, unsigned n) {
   const auto target = slot_for(layout, n).address;
   require_playable(l, layout, n, fmt::format("a button playing motion {}", n));
+  // The board compares the table with the button word every period: an entry for the buttons held
+  // now (a press --hold, a receiver's remote) would start the motion the moment it is written.
+  const auto word = run(l, rcb4::ops::read_memory(memory::ram, krr::buttons.value(), 2));
+  if (buttons != 0 && krr::decode_buttons(word[0], word[1]) == buttons)
+    throw refused(refusal_kind::board,
+                  fmt::format("{} are held now: an entry for them would play motion {} at once, so nothing was "
+                              "written",
+                              mo::buttons_text(buttons), n),
+                  "rcb4 motion buttons release lets them go (or let go of the remote)");
   const auto t = read_buttons(l);
   auto entries = mo::assign_button(editable(t), buttons, target);
   if (!mo::ok(entries)) throw refused(refusal_kind::board, std::get<mo::failure>(entries).message);

@@ -22,7 +22,7 @@ using rcb4::ops::memory;
 constexpr std::chrono::milliseconds callee_poll = 50ms;
 
 compiled_motion checked(link& l, const model& robot, const rom_layout& layout, output_period period,
-                        const motion_document& d, const std::string& file, bool rescale) {
+                        const motion_document& d, const std::string& file, bool rescale, servo_mask& on_board) {
   auto c = to_program(d, robot, layout, period, rescale);
   if (!ok(c))
     throw refused(refusal_kind::usage, fmt::format("{}: {} (nothing was sent)", file, std::get<problem>(c).message));
@@ -36,6 +36,7 @@ compiled_motion checked(link& l, const model& robot, const rom_layout& layout, o
   const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
   const auto slots = rcb4::ops::parse_allocation_table(table);
   if (!slots) l.failed(slots.error());
+  for (const auto& k : *slots) on_board.insert(k.ics);
   for (const auto& st : cm.program.steps)
     if (const auto* p = std::get_if<mo::pose>(&st))
       for (const auto& e : p->targets)
@@ -64,7 +65,7 @@ host_play::host_play(link& l, const model& robot, const rom_layout& layout, outp
       period_(period),
       file_(std::move(file)),
       callee_limit_(callee_limit),
-      compiled_(checked(l, robot, layout, period, d, file_, rescale)),
+      compiled_(checked(l, robot, layout, period, d, file_, rescale, slots_)),
       player_(compiled_.program) {}
 
 std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::milliseconds now) {
@@ -125,8 +126,12 @@ void host_play::stop() {
     callee_since_.reset();
     run(l_, rcb4::ops::stop_motion{});
   }
-  // A pose under way would go on to its end: every servo the play moved holds where it is now.
-  if (!moved_.empty()) run(l_, rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, moved_));
+  // A pose under way would go on to its end: every servo the play moved holds where it is now,
+  // and after a call every servo on the board (the called motion's last pose may still be under way).
+  auto hold = moved_;
+  if (player_.calls() > 0)
+    for (const auto ics : slots_) hold.insert(ics);
+  if (!hold.empty()) run(l_, rcb4::ops::set_servo_power(rcb4::ops::power_state::hold, hold));
 }
 
 }  // namespace rcb4::robot::services

@@ -53,7 +53,11 @@ class host_play {
    * limit (stopped on the board first).
    */
   std::optional<std::chrono::milliseconds> advance(std::chrono::milliseconds now);
-  /** Interrupted: a ROM motion it called is stopped on the board, and every servo it moved holds where it is now. */
+  /**
+   * Interrupted: a ROM motion it called is stopped on the board, and every servo it moved holds
+   * where it is now; once it has called a ROM motion, every servo the board has a slot for (the
+   * called motion's pose under way would go on to its end).
+   */
   void stop();
 
   /** Notes on the file (times rounded to frames, a rescale, steps that never run). */
@@ -73,6 +77,7 @@ class host_play {
   output_period period_;
   std::string file_;
   std::chrono::milliseconds callee_limit_;
+  servo_mask slots_;  ///< the servos the board has a slot for (read when it is checked)
   compiled_motion compiled_;
   motion::player player_;
   std::chrono::milliseconds ready_{};                      ///< when the board has reached the last pose sent
