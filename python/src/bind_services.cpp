@@ -275,9 +275,12 @@ void bind_services(py::class_<board>& cls) {
             const std::string to = backup.is_none() ? std::string() : path_of(backup);
             const auto r = unlocked([&] { return b.erase_motion(k, to); });
             return py::dict("motion"_a = r.motion, "address"_a = r.address, "unchanged"_a = r.unchanged,
-                            "backup"_a = r.backup.empty() ? py::object(py::none()) : py::object(py::str(r.backup)));
+                            "backup"_a = r.backup.empty() ? py::object(py::none()) : py::object(py::str(r.backup)),
+                            "callers"_a = r.callers);
           },
-          "n"_a, "backup"_a = py::none(), "Empties motion n (0xFF), its old bytes saved to backup first.")
+          "n"_a, "backup"_a = py::none(),
+          "Empties motion n (0xFF), its old bytes saved to backup first; callers: the used slots that call it (a play "
+          "of them is refused from now on).")
       .def(
           "buttons",
           [](board& b) {

@@ -355,28 +355,34 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             const auto& layout = unlocked([&]() -> const rcb4::rom_layout& { return b.rom_layout(); });
             const auto names = load_names(b);
             py::list out;
-            for (const auto& s : v) {
+            const auto states = rcb4::robot::services::slot_states(v, layout);
+            for (std::size_t i = 0; i < v.size(); ++i) {
+              const auto& s = v[i];
+              const auto& state = states[i];
               const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names);
               // Its seconds as the board plays it (loops counted, no button held), where the steps express it.
               py::object seconds = py::none();
-              if (const auto t = rcb4::robot::services::slot_play_time(s, layout)) {
+              if (const auto& t = state.plays) {
                 if (const auto secs = rcb4::robot::services::play_seconds(*t, period))
                   seconds = py::float_(*secs);
                 else if (t->endless)
                   seconds = py::float_(std::numeric_limits<double>::infinity());
               }
-              out.append(
-                  py::dict("slot"_a = s.number,
-                           "name"_a = name.empty() ? py::object(py::none()) : py::object(py::str(std::string(name))),
-                           "address"_a = s.address, "size"_a = s.size, "frames"_a = s.frames, "seconds"_a = seconds,
-                           "ends"_a = s.ends, "readable"_a = s.readable));
+              out.append(py::dict(
+                  "slot"_a = s.number,
+                  "name"_a = name.empty() ? py::object(py::none()) : py::object(py::str(std::string(name))),
+                  "address"_a = s.address, "size"_a = s.size, "frames"_a = s.frames, "seconds"_a = seconds,
+                  "ends"_a = s.ends, "readable"_a = s.readable, "endless"_a = state.endless,
+                  "broken"_a = !state.problem.empty(),
+                  "problem"_a = state.problem.empty() ? py::object(py::none()) : py::object(py::str(state.problem))));
             }
             return out;
           },
           "The used motion slots in ROM: slot, name (the slot's name, kept when a motion file with a name is pushed; "
           "else the profile's), address, size, frames (the protocol's commands walked to the first RETURN), seconds "
           "(as the board plays it, loops counted; inf: for ever; None: it calls other motions or is not steps), "
-          "ends, readable.")
+          "ends (a RETURN reached), readable, endless (a loop with no way out), broken and problem (why a play would "
+          "stop the board's program: a bad frame, no way out, a call of an empty or broken slot; else None).")
       .def(
           "sensors",
           [](board& b) {

@@ -117,6 +117,24 @@ def test_play_refuses_a_broken_slot(board, tmp_path):
     assert not board.motion_status()["running"]
 
 
+def test_a_loop_plays_and_a_caller_of_an_erased_slot_does_not(board, tmp_path):
+    loop = [{"label": "top"}, {"pose": {"head_yaw": 20}, "time_ms": 150}, {"pose": {"head_yaw": -20}, "time_ms": 150},
+            {"goto": "top"}]
+    board.push_motion(loop, 93, backup=tmp_path / "93.bin")
+    board.push_motion([{"pose": {"left_knee": 40}, "time_ms": 900}, {"call": 93}, "end"], 94, backup=tmp_path / "94.bin")
+    listed = {m["slot"]: m for m in board.motions()}
+    assert listed[93]["endless"] and listed[93]["seconds"] == float("inf") and not listed[93]["broken"]
+    assert not listed[94]["broken"] and listed[94]["problem"] is None
+    assert board.erase_motion(93, backup=tmp_path / "93b.bin")["callers"] == [94]
+    listed = {m["slot"]: m for m in board.motions()}
+    assert listed[94]["broken"] and "calls motion 93, which holds no motion" in listed[94]["problem"]
+    knee = board.joints()["left_knee"]
+    with pytest.raises(pyrcb4.BoardRefused, match="motion 94 calls motion 93 .* holds no motion"):
+        board.play_motion(94)
+    assert not board.motion_status()["running"] and board.joints()["left_knee"] == knee
+    board.erase_motion(94, backup=tmp_path / "94b.bin")
+
+
 def test_buttons(board):
     t = board.buttons()
     assert t["same"] and [e["buttons"] for e in t["ram"]] == ["up", "down"]

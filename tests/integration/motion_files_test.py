@@ -37,6 +37,11 @@ def joints_deg(on):
     return {x["name"]: x["degrees"] for x in json.loads(out)} if rc == 0 else {}
 
 
+def status(on):
+    rc, out, err = run("--json", *on, "motion", "status")
+    return json.loads(out) if rc == 0 else {}
+
+
 def rom(on, address, n):
     rc, out, err = run("--json", *on, "read", "rom", hex(address), str(n))
     return bytes(json.loads(out)["bytes"]) if rc == 0 else b""
@@ -199,11 +204,21 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     write("calls9.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - call: 9\n  - end\n")
     rc, out, err = run(*on, "motion", "push", "calls9.yaml", "6")
     check(rc == 1 and "step 1 (calls9.yaml:4) calls motion 9 (0x004B80), which holds no motion" in err, f"push of a call of an empty slot: exit 1 ({rc}: {err.strip()!r})")
-    # A ROM motion that calls an empty slot (written raw): the board's program stops on an error.
+    # A ROM motion that calls an empty slot (written raw): not played, nothing moves.
     run(*on, "write", "rom", "0x3B80", "07 0C 80 4B 00 00 DE 03 0D 10")
     rc, out, err = run(*on, "motion", "play", "7", "--wait", "--timeout", "5")
+    check(rc == 1 and "motion 7 calls motion 9 (0x004B80), which holds no motion" in err and not status(on).get("running"),
+          f"a play of a motion that calls an erased slot: refused ({rc}: {err.strip()!r})")
+    # Its callee overwritten while it runs (another program's raw write): the board's program
+    # stops on an error, and the tool says so.
+    write("slow9.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {left_knee: 5}\n    time_ms: 1500\n  - end\n")
+    run(*on, "motion", "push", "slow9.yaml", "9")
+    nine = rom(on, 0x4B80, 64)
+    rc, out, err = run(*on, "motion", "play", "7")
+    run(*on, "write", "rom", hex(0x4B80 + nine[0]), *(["FF"] * (len(nine.rstrip(b"\xff")) - nine[0])))
+    rc, out, err = run(*on, "motion", "wait", "--timeout", "5")
     check(rc == 1 and "on an error of the board's program" in err and "motion play N" in err,
-          f"a call of an erased slot stops the program: exit 1, saying so ({rc}: {err.strip()!r})")
+          f"a callee overwritten under way stops the program: exit 1, saying so ({rc}: {err.strip()!r})")
     rc, out, err = run("--json", *on, "motion", "status")
     check(rc == 0 and json.loads(out).get("program_error") is True, f"status says program_error ({out.strip()!r})")
     rc, out, err = run(*on, "motion", "resume")
@@ -213,6 +228,7 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     rc, out, err = run("--json", *on, "config")
     check(rc == 0 and json.loads(out)["program_error"] is False, "and clears the old program error")
     run(*on, "write", "rom", "0x3B80", "FF FF FF FF FF FF FF FF FF FF")
+    run(*on, "write", "rom", "0x4B80", *(["FF"] * nine[0]))
     rc, out, err = run(*on, "motion", "erase", "9")
     check(rc == 0 and "already empty" in out, f"erase of an empty slot writes nothing ({rc}: {out.strip()!r})")
 
@@ -251,6 +267,9 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     write("unslotted.yaml", "robot: KHR-3HV\nperiod_ms: 15\nsteps:\n  - pose: {\"ics 30\": 7500}\n    time_ms: 150\n  - end\n")
     rc, out, err = run(*on, "motion", "play", "unslotted.yaml")
     check(rc == 1 and "(ICS 30) has no slot on the board" in err, f"a servo without a slot: exit 1, nothing sent ({rc}: {err.strip()!r})")
+    rc, out, err = run(*on, "motion", "push", "unslotted.yaml", "37")
+    check(rc == 1 and "(ICS 30) has no slot on the board" in err and "nothing was written" in err,
+          f"and a push of it: exit 1, nothing written ({rc}: {err.strip()!r})")
     rc, out, err = run(*on, "motion", "play", "knee10.yaml")
     check(rc == 2 and "--rescale" in err, f"play of a file for another period: exit 2 ({rc}: {err.strip()!r})")
     # A motion that never ends, stopped with Ctrl-C.
@@ -423,10 +442,11 @@ run("--device", StandIn().path, "motion", "record", "stopped.yaml", "--joints", 
 rc, out, err = run("--device", StandIn().path, "motion", "record", "stopped.yaml", "--for", "0.2")
 check(rc == 2 and "exists" in err, f"record does not replace a file ({rc}: {err.strip()!r})")
 
-# Boards that are not ours.
+# Boards that are not ours (the stand-in has slots for ICS 0-2 only: head_yaw, waist_yaw, left_shoulder_pitch).
+write("knee10.yaml", "robot: KHR-3HV\nperiod_ms: 10\nsteps:\n  - pose: {head_yaw: 10, waist_yaw: -5}\n    time_ms: 300\n  - end\n")
 board = StandIn()  # acknowledges ROM writes and keeps nothing
 rc, out, err = run("--device", board.path, "motion", "push", "knee10.yaml", "1", "--layout", "2.2", "--backup", "x.bin")
-check(rc == 1 and "ROM 0x000B80 reads back 0xFF, 0x08 was written" in err and "rcb4 motion push x.bin 1 puts them back" in err,
+check(rc == 1 and "ROM 0x000B80 reads back 0xFF, 0x0D was written" in err and "rcb4 motion push x.bin 1 puts them back" in err,
       f"a board that does not keep ROM writes: exit 1, the backup and the command that puts it back named ({rc}: {err.strip()!r})")
 # A board that dies at every point of a push: once the backup exists, the failure (in the write or
 # the read-back) names it and the command that puts the slot back.

@@ -184,6 +184,41 @@ with serve("--period", "15") as dev:
     check(rc == 0 and not status(on).get("running"), f"released, the entry is set and nothing plays ({rc}: {err.strip()!r})")
     run(*on, "motion", "buttons", "clear", "triangle+square")
 
+    # A loop with no way out (goto, no RETURN) plays until stopped: listed as endless, not broken.
+    write("loop.yaml", HEAD + "  - label: top\n  - pose: {head_yaw: 20}\n    time_ms: 150\n"
+                              "  - pose: {head_yaw: -20}\n    time_ms: 150\n  - goto: top\n")
+    write("calls_loop.yaml", HEAD + "  - pose: {left_knee: 40}\n    time_ms: 900\n  - call: 93\n  - end\n")
+    run(*on, "motion", "push", "loop.yaml", "93")
+    run(*on, "motion", "push", "calls_loop.yaml", "94")
+
+    def listed(n):
+        rc, out, _ = run("--json", *on, "motion", "list")
+        return next((m for m in json.loads(out)["motions"] if m["slot"] == n), {}) if rc == 0 else {}
+    m93, m94 = listed(93), listed(94)
+    check(m93.get("endless") is True and m93.get("broken") is False and m94.get("broken") is False,
+          f"motion list: a goto loop is endless, not broken, and so is its caller ({m93}, {m94})")
+    rc, out, err = run(*on, "motion", "list")
+    line = next((x for x in out.splitlines() if x.strip().startswith("93 ")), "")
+    check(rc == 0 and "for ever" in line and "broken" not in line, f"motion list's line for 93: for ever ({line!r})")
+    # Its callee erased: the erase says who calls it, the caller is listed broken and not played.
+    rc, out, err = run(*on, "motion", "erase", "93")
+    check(rc == 0 and "note: motion 94 calls it" in err, f"erase of a called slot names its caller ({rc}: {err.strip()!r})")
+    m94 = listed(94)
+    check(m94.get("broken") is True and "calls motion 93, which holds no motion" in (m94.get("problem") or ""),
+          f"motion list: the caller of an empty slot is broken ({m94})")
+    rc, out, _ = run("--json", *on, "joint", "list")
+    before = {j["name"]: j["degrees"] for j in json.loads(out)} if rc == 0 else {}
+    rc, out, err = run(*on, "motion", "play", "94")
+    time.sleep(0.3)
+    rc2, out2, _ = run("--json", *on, "joint", "list")
+    after = {j["name"]: j["degrees"] for j in json.loads(out2)} if rc2 == 0 else {}
+    check(rc == 1 and "motion 94 calls motion 93 (0x" in err and "holds no motion" in err and not status(on).get("running")
+          and before.get("left_knee") == after.get("left_knee"),
+          f"motion play of a caller of an empty slot: refused before anything moves ({rc}: {err.strip()!r}; knee {before.get('left_knee')} -> {after.get('left_knee')})")
+    rc, out, err = run(*on, "motion", "buttons", "set", "s4", "94")
+    check(rc == 1 and "holds no motion" in err, f"nor is a button set to play it ({rc}: {err.strip()!r})")
+    run(*on, "motion", "erase", "94")
+
     # A file far larger than any motion: refused by its size, at once, nothing written.
     with open("huge.yaml", "w") as f:
         f.write(HEAD)

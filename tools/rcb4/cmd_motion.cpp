@@ -372,11 +372,14 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                  "seconds", "");
     const auto period = s.run(rcb4::ops::read_config{}).period;
     const auto names = rcb4::robot::services::load_slot_names(m.name());
-    for (const auto& v : op.value()) {
+    const auto states = rcb4::robot::services::slot_states(op.value(), layout);
+    for (std::size_t i = 0; i < op.value().size(); ++i) {
+      const auto& v = op.value()[i];
+      const auto& state = states[i];
       const auto name = rcb4::robot::services::slot_name(m, v.number, names);
       // Its time as the board plays it (loops counted); one that calls others plays for as long as
       // they do too: not counted here ("calls").
-      const auto plays = rcb4::robot::services::slot_play_time(v, layout);
+      const auto& plays = state.plays;
       // (A lambda, not ?: : GCC 12 at -O3 takes the ?: optional's payload for uninitialised.)
       const auto seconds = [&]() -> std::optional<double> {
         if (!plays) return std::nullopt;
@@ -387,7 +390,6 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                                        : plays->calls   ? "calls"
                                        : seconds        ? fmt::format("{:.2f}", *seconds)
                                                         : "-";
-      const std::string note = !v.readable ? "not a frame: another --layout?" : v.ends ? "" : "no RETURN found";
       if (ctx.g.json)
         arr.push_back({{"slot", v.number},
                        {"name", name.empty() ? json(nullptr) : json(std::string(name))},
@@ -396,12 +398,14 @@ void add_motion_commands(CLI::App& app, context& ctx) {
                        {"frames", v.frames},  // kept for scripts: the same count as "commands"
                        {"commands", v.frames},
                        {"seconds", seconds ? json(*seconds) : json(nullptr)},  // loops counted; calls not
-                       {"endless", plays && plays->endless},
-                       {"ends", v.ends},
-                       {"readable", v.readable}});
+                       {"endless", state.endless},
+                       {"ends", v.ends},  // a RETURN was reached (a loop with no way out plays: endless)
+                       {"readable", v.readable},
+                       {"broken", !state.problem.empty()},
+                       {"problem", state.problem.empty() ? json(nullptr) : json(state.problem)}});
       else
         fmt::print("{:>4}  {:<20} 0x{:05X}  {:>6}  {:>8}  {:>8}  {}\n", v.number, name.empty() ? "-" : name, v.address,
-                   v.size, v.frames, seconds_text, note);
+                   v.size, v.frames, seconds_text, state.problem.empty() ? "" : "broken: " + state.problem);
     }
     if (ctx.g.json)
       emit(json{{"layout", layout.name}, {"motions", arr}});

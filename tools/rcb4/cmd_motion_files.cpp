@@ -10,6 +10,7 @@
 #include <rcb4/robot/services/motion_slots.hpp>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <ctime>
 #include <filesystem>
@@ -182,13 +183,19 @@ int erase(session& s, const push_options& o, const globals& g) {
   }
   warn_buttons(s, mo::slot_of(layout, n).value(), n,
                "a press now stops the board's program (rcb4 motion buttons clear)", g);
+  if (!r.callers.empty() && !g.json)
+    fmt::print(stderr, "note: {} {} {} it: {} refused from now on (played, {} stop the board's program there)\n",
+               r.callers.size() == 1 ? "motion" : "motions", fmt::join(r.callers, ", "),
+               r.callers.size() == 1 ? "calls" : "call", r.callers.size() == 1 ? "its play is" : "their plays are",
+               r.callers.size() == 1 ? "it would" : "they would");
   // Motion 1 is where the layout is told from: without it, --layout must say it.
   const std::string again = n == 1 && o.m.layout == "auto" ? fmt::format(" --layout {}", layout_flag(layout)) : "";
   if (!again.empty() && !g.json)
     fmt::print(stderr, "note: motion 1 told the board's layout ({}); from now on give it: --layout {}\n", layout.name,
                layout_flag(layout));
   if (g.json)
-    emit(json{{"erased", n}, {"address", r.address}, {"unchanged", false}, {"backup", r.backup}});
+    emit(json{
+        {"erased", n}, {"address", r.address}, {"unchanged", false}, {"backup", r.backup}, {"callers", r.callers}});
   else
     fmt::print(
         "erased motion {} (0x{:06X}, {} bytes of 0xFF, read back); the old bytes are in {} "

@@ -32,22 +32,7 @@ compiled_motion checked(link& l, const model& robot, const rom_layout& layout, o
     if (!probe.error().empty()) throw refused(refusal_kind::usage, fmt::format("{}: {}", file, probe.error()));
   }
   require_no_motion(l, layout);
-  // Every servo a pose moves needs a slot: the board ignores one it has none for.
-  const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
-  const auto slots = rcb4::ops::parse_allocation_table(table);
-  if (!slots) l.failed(slots.error());
-  for (const auto& k : *slots) on_board.insert(k.ics);
-  for (const auto& st : cm.program.steps)
-    if (const auto* p = std::get_if<mo::pose>(&st))
-      for (const auto& e : p->targets)
-        if (std::none_of(slots->begin(), slots->end(), [&](const auto& k) { return k.ics == e.ics; })) {
-          const auto* j = robot.on(e.ics);
-          throw refused(refusal_kind::board,
-                        fmt::format("{} (ICS {}) has no slot on the board: its poses would not move it, so nothing "
-                                    "was sent",
-                                    j ? j->name : "a servo", e.ics.value()),
-                        "rcb4 scan shows the board's slots");
-        }
+  on_board = require_servo_slots(l, robot, cm.program, "sent");
   // Its calls checked as a push checks them (the host plays the poses; the board runs each call).
   const auto whole = mo::slot{rcb4::rom_address{}, 0x40000};
   if (const auto code = mo::assemble(cm.program, whole); mo::ok(code))
@@ -57,6 +42,26 @@ compiled_motion checked(link& l, const model& robot, const rom_layout& layout, o
 }
 
 }  // namespace
+
+servo_mask require_servo_slots(link& l, const model& robot, const motion::program& p, std::string_view done) {
+  const auto table = run(l, rcb4::ops::read_memory(memory::ram, rcb4::ram::ics_allocation.value(), 70));
+  const auto slots = rcb4::ops::parse_allocation_table(table);
+  if (!slots) l.failed(slots.error());
+  servo_mask on_board;
+  for (const auto& k : *slots) on_board.insert(k.ics);
+  for (const auto& st : p.steps)
+    if (const auto* pose = std::get_if<mo::pose>(&st))
+      for (const auto& e : pose->targets)
+        if (!on_board.contains(e.ics)) {
+          const auto* j = robot.on(e.ics);
+          throw refused(refusal_kind::board,
+                        fmt::format("{} (ICS {}) has no slot on the board: its poses would not move it, so nothing "
+                                    "was {}",
+                                    j ? j->name : "a servo", e.ics.value(), done),
+                        "rcb4 scan shows the board's slots");
+        }
+  return on_board;
+}
 
 host_play::host_play(link& l, const model& robot, const rom_layout& layout, output_period period,
                      const motion_document& d, std::string file, bool rescale, std::chrono::milliseconds callee_limit)

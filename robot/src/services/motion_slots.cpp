@@ -6,6 +6,8 @@
 #include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
+#include "slot_address.hpp"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -35,22 +37,6 @@ using rcb4::ops::memory;
 
 /** The board's call stack (protocol.md §4: 16 deep); a motion played takes one level itself (§8.1). */
 constexpr unsigned stack_depth = 16;
-
-/** The motion slot that holds ROM address @p a, if any. */
-std::optional<unsigned> slot_number(const rom_layout& layout, std::uint32_t a) {
-  const std::uint32_t base = layout.motion_base.value();
-  if (a < base || (a - base) / layout.slot_size >= layout.motion_count) return std::nullopt;
-  return (a - base) / layout.slot_size + 1;
-}
-
-/** "motion 5 (0x002B80)", or the address alone outside the slots. */
-std::string name_of(const rom_layout& layout, std::uint32_t a) {
-  const auto n = slot_number(layout, a);
-  if (!n) return mo::hex_address(a);
-  const std::uint32_t start = layout.motion_base.value() + (*n - 1) * layout.slot_size;
-  return a == start ? fmt::format("motion {} ({})", *n, mo::hex_address(a))
-                    : fmt::format("motion {} at {}", *n, mo::hex_address(a));
-}
 
 /** The code from @p at to the end of its slot (or 2 KiB outside the slots) as the board runs it. */
 struct code_at {
@@ -184,28 +170,6 @@ void write_rom_checked(link& l, std::uint32_t at, std::span<const std::uint8_t> 
 }
 
 }  // namespace
-
-std::optional<motion::play_estimate> slot_play_time(const ops::motion_slot& s, const rom_layout& layout) {
-  if (!s.ends) return std::nullopt;
-  const mo::slot where{rom_address::make(s.address).value(), layout.slot_size};
-  auto p = mo::lift(mo::disassemble(s.code, where));
-  if (!mo::ok(p)) return std::nullopt;
-  return mo::play_time(std::get<mo::program>(p));
-}
-
-std::optional<double> play_seconds(const motion::play_estimate& e, output_period period) {
-  if (e.endless || !e.error.empty() || e.calls) return std::nullopt;
-  return std::round(static_cast<double>(e.frames) * rcb4::milliseconds(period) / 10.0) / 100.0;
-}
-
-std::string play_time_text(const motion::play_estimate& e, output_period period) {
-  if (!e.error.empty()) return "cannot be played: " + e.error;
-  if (e.endless) return "plays until stopped: it goes round for ever";
-  std::string t = fmt::format("plays {:.2f} s", static_cast<double>(e.frames) * rcb4::milliseconds(period) / 1000.0);
-  if (e.calls) t += fmt::format(" and {} call{} of other motions", e.calls, e.calls == 1 ? "" : "s");
-  if (e.reads) t += ", no button held";
-  return t;
-}
 
 std::string file_stamp() {
   char stamp[32];
@@ -388,7 +352,31 @@ void require_playable(link& l, const rom_layout& layout, unsigned n, std::string
   const auto where = slot_for(layout, n);
   rom_code rom(l, layout, nullptr);
   const auto& c = rom.at(where.address.value());
-  if (c.problems.empty()) return;
+  if (c.problems.empty()) {
+    // Its calls, through any number of slots: an empty or broken one stops the board's program
+    // when the play reaches it (after the robot has moved), so the play is refused before it starts.
+    std::map<std::uint32_t, std::uint32_t> via;  // callee -> the code that calls it
+    std::vector<std::uint32_t> todo(c.calls.begin(), c.calls.end());
+    for (const auto a : todo) via.emplace(a, where.address.value());
+    while (!todo.empty()) {
+      const auto a = todo.back();
+      todo.pop_back();
+      const auto& k = rom.at(a);
+      if (!k.problems.empty()) {
+        std::string chain = name_of(layout, a);
+        for (auto at = via.at(a); at != where.address.value(); at = via.at(at))
+          chain = name_of(layout, at) + " → " + chain;
+        throw refused(refusal_kind::board,
+                      fmt::format("{}motion {} calls {}, which {}: a play would stop the board's program there",
+                                  what.empty() ? std::string() : std::string(what) + ": ", n, chain,
+                                  k.code.empty() ? "holds no motion" : "is broken (" + first_problem(k) + ")"),
+                      "push that motion (again), or push the caller without the call");
+      }
+      for (const auto b : k.calls)
+        if (via.emplace(b, a).second) todo.push_back(b);
+    }
+    return;
+  }
   throw refused(refusal_kind::board,
                 fmt::format("{}motion {} (0x{:06X}) {}: a play would stop the board's program there",
                             what.empty() ? std::string() : std::string(what) + ": ", n, where.address.value(),
@@ -448,6 +436,7 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
     r.notes = cm.notes;
     code = mo::disassemble(r.bytes, where);
     check_calls(l, layout, code, &cm.program, d.where, "written");
+    require_servo_slots(l, robot, cm.program, "written");
     std::size_t poses = 0;
     for (const auto& st : cm.program.steps)
       if (std::holds_alternative<mo::pose>(st)) ++poses;
@@ -480,7 +469,7 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
 erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const backup_sink& backup,
                           const std::string& robot) {
   const auto where = slot_for(layout, n);
-  erase_report r{n, where.address.value(), where.size, false, {}};
+  erase_report r{n, where.address.value(), where.size, false, {}, {}};
   const auto forget = [&] {
     if (robot.empty()) return;
     try {
@@ -499,6 +488,17 @@ erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const b
   const std::vector<std::uint8_t> erased(where.size, 0xFF);
   write_rom_checked(l, r.address, erased, fmt::format("erasing motion {}", n), n, r.backup);
   forget();
+  // The motions that call it now stop the board's program where they do: said, so a play of
+  // them is not a surprise (plays and buttons refuse them from now on).
+  rom_code rom(l, layout, nullptr);
+  for (unsigned k = 1; k <= layout.motion_count; ++k) {
+    const std::uint32_t a = layout.motion_base.value() + (k - 1) * layout.slot_size;
+    if (k == n) continue;
+    l.progress("looking for motions that call it", k, layout.motion_count);
+    if (run(l, rcb4::ops::read_memory(rcb4::ops::memory::rom, a, 1))[0] == 0xFF) continue;  // empty
+    const auto& calls = rom.at(a).calls;
+    if (std::find(calls.begin(), calls.end(), r.address) != calls.end()) r.callers.push_back(k);
+  }
   return r;
 }
 

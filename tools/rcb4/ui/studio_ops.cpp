@@ -163,7 +163,7 @@ json studio_ops::act(const studio_action& a, client_id from) {
       return push(slot(), args.at("text").get<std::string>(), args.value("dry_run", false), backup);
     if (op == "motion_erase") {
       const auto r = sv::erase_motion(link_, *o_.layout, slot(), backup, m_.name());
-      return json{{"slot", r.motion}, {"unchanged", r.unchanged}, {"backup", r.backup}};
+      return json{{"slot", r.motion}, {"unchanged", r.unchanged}, {"backup", r.backup}, {"callers", r.callers}};
     }
     if (op == "motion_resume") {
       sv::run(link_, rcb4::ops::resume_motion());
@@ -232,6 +232,7 @@ json studio_ops::list() {
   const auto used = sv::run(link_, rcb4::ops::list_motions(layout));
   const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
   const auto names = sv::load_slot_names(m_.name());
+  const auto states = sv::slot_states(used, layout);
   json slots = json::array();
   for (unsigned n = 1; n <= layout.motion_count; ++n) {
     json e{{"slot", n}, {"name", sv::slot_name(m_, n, names)}};
@@ -240,9 +241,11 @@ json studio_ops::list() {
     if (it != used.end()) {
       e["bytes"] = it->size;
       e["commands"] = it->frames;
-      e["broken"] = !it->ends || !it->readable;
+      const auto& state = states[static_cast<std::size_t>(it - used.begin())];
+      e["broken"] = !state.problem.empty();
+      if (!state.problem.empty()) e["problem"] = state.problem;
       e["seconds"] = nullptr;
-      if (const auto t = sv::slot_play_time(*it, layout)) {
+      if (const auto& t = state.plays) {
         e["endless"] = t->endless;
         e["calls"] = t->calls;  // their time is not counted: no seconds then
         if (const auto s = sv::play_seconds(*t, period)) e["seconds"] = *s;

@@ -86,7 +86,7 @@ export function createTables(root, ctx) {
     slots = r.slots;
     tbody.replaceChildren(...slots.map((s) => el('tr', { 'data-slot': s.slot, class: (s.used ? 'used' : 'free') + (s.broken ? ' broken' : '') },
       el('td', { text: String(s.slot) }),
-      el('td', { text: s.used ? (s.name || '') + (s.broken ? ' (broken)' : '') : 'free' }),
+      el('td', { text: s.used ? (s.name || '') + (s.broken ? ' (broken)' : '') : 'free', title: s.problem || '' }),
       el('td', { text: s.used ? String(s.bytes) : '' }),
       el('td', { text: s.used ? (s.endless ? '∞' : s.calls ? 'calls' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
       el('td', {}, ...(s.used ? [

@@ -60,9 +60,29 @@ std::string play_time_text(const motion::play_estimate& e, output_period period)
 
 /**
  * How long a slot ops::list_motions walked plays as the board runs it (loops counted, no button
- * held), when it ends and its code is one the steps express; nothing otherwise.
+ * held), when it plays (to a RETURN, or round for ever) and its code is one the steps express;
+ * nothing otherwise.
  */
 std::optional<motion::play_estimate> slot_play_time(const ops::motion_slot& s, const rom_layout& layout);
+
+/** A used slot as the board runs it (the tool's, the studio's and pyrcb4's motion lists). */
+struct slot_state {
+  std::optional<motion::play_estimate> plays;  ///< its play time (slot_play_time)
+  bool endless = false;                        ///< it goes round for ever (a goto loop with no way out)
+  /**
+   * Why a play of it would stop the board's program ("" when it plays): its first frame is not
+   * one (another layout?), a bad frame or no way out (no RETURN, no loop), or a call (through any
+   * number of slots) of a slot that is empty or broken.
+   */
+  std::string problem;
+};
+
+/**
+ * Each of @p used's slots (ops::list_motions' walk, ascending) as the board runs it, in the same
+ * order. A slot's code is followed as the board runs it, so a loop that never reaches a RETURN
+ * plays; its calls are followed through @p used.
+ */
+std::vector<slot_state> slot_states(const std::vector<ops::motion_slot>& used, const rom_layout& layout);
 
 /**
  * @p e's seconds at @p period, to the hundredth; nothing when it goes round for ever, cannot be
@@ -103,11 +123,12 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
 
 /** What an erase did. */
 struct erase_report {
-  unsigned motion = 0;        ///< the slot's number
-  std::uint32_t address = 0;  ///< its first byte
-  std::uint32_t size = 0;     ///< bytes set to 0xFF
-  bool unchanged = false;     ///< it was already empty
-  std::string backup;         ///< where its old bytes are
+  unsigned motion = 0;            ///< the slot's number
+  std::uint32_t address = 0;      ///< its first byte
+  std::uint32_t size = 0;         ///< bytes set to 0xFF
+  bool unchanged = false;         ///< it was already empty
+  std::string backup;             ///< where its old bytes are
+  std::vector<unsigned> callers;  ///< the used slots that call it (a play of them now stops the board's program)
 };
 
 /**
@@ -150,6 +171,13 @@ void require_playable(link& l, const rom_layout& layout, unsigned n, std::string
  */
 void check_calls(link& l, const rom_layout& layout, const motion::listing& code, const motion::program* steps,
                  const std::vector<std::string>& where_, std::string_view done);
+
+/**
+ * Refuses @p p when one of its poses moves a servo the board has no slot for (the board ignores
+ * it, so the pose would not move it); @p done is what did not happen ("written", "sent"). Returns
+ * the servos the board has a slot for.
+ */
+servo_mask require_servo_slots(link& l, const model& robot, const motion::program& p, std::string_view done);
 
 /**
  * Refuses to replace motion @p n (whose bytes now are @p old) while the board's program could run
