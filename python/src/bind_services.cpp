@@ -348,7 +348,8 @@ void bind_services(py::class_<board>& cls) {
             try {
               image = sv::load_rom_image(p, no_check);
             } catch (const sv::refused& e) {
-              throw board_error(fault::usage, e.what());
+              throw board_error(fault::usage, python_words(std::string("rom_restore: ") + e.what() +
+                                                           (e.hint.empty() ? "" : " (" + e.hint + ")")));
             }
             const auto version = unlocked([&] { return b.version(); });
             const auto save = [&](std::span<const std::uint8_t> now) {

@@ -9,6 +9,7 @@
 #include <rcb4/transport/serial.hpp>
 #include <rcb4/transport/tcp.hpp>
 
+#include <fmt/format.h>
 #include <termios.h>
 #include <unistd.h>
 
@@ -356,7 +357,7 @@ std::vector<std::string> board::set_param(bool speed, long long value, const std
 
 motion_status board::motion() {
   const auto st = run(rcb4::ops::read_motion_state(layout()), "motion state");
-  return {st.running, st.suspended, st.motion, st.program_counter};
+  return {st.running, st.suspended, st.motion, st.program_counter, st.program_on};
 }
 
 motion_status board::wait_motion(double seconds, const interrupt_check& check) {
@@ -368,7 +369,7 @@ motion_status board::wait_motion(double seconds, const interrupt_check& check) {
     if (!st.running) return st;
     if (closing_) throw board_error(fault::closed, "wait_motion: the board was closed");
     if (std::chrono::steady_clock::now() >= deadline)
-      throw board_error(fault::timeout, "the motion still runs after " + std::to_string(seconds) + " s");
+      throw board_error(fault::timeout, fmt::format("wait_motion: the motion still runs after {:g} s", seconds));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the board refreshes the state every 50 ms
     if (check) check();
   }

@@ -44,6 +44,13 @@ struct board_error : std::runtime_error {
   int err;     ///< the OS error number of a device error, or 0
 };
 
+/**
+ * A service's words for Python: its hints name the rcb4 tool's commands and options (one text for
+ * every front end); here they name the Board's methods and arguments instead ("rcb4 motion show
+ * 70" becomes "show_motion(70)").
+ */
+std::string python_words(std::string text);
+
 /** How long a wait may go on before it checks for Ctrl-C (module.cpp passes PyErr_CheckSignals). */
 using interrupt_check = std::function<void()>;
 
@@ -56,6 +63,7 @@ struct motion_status {
   bool running = false, suspended = false;
   std::optional<unsigned> motion;
   std::uint32_t program_counter = 0;
+  bool program_on = true;  ///< the ROM program runs (off: buttons play nothing until resume_motion)
 };
 
 /** One reading of the board's inputs. */

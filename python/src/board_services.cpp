@@ -8,6 +8,7 @@
 #include <rcb4/ops/memory.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <string_view>
 #include <thread>
 #include <utility>
@@ -34,10 +35,19 @@ class client_link final : public sv::link {
   t::response last_;
 };
 
-/**
- * A service's words for Python: its hints name the rcb4 tool's commands and options (one text for
- * every front end); here they name the Board's methods and arguments instead.
- */
+/** The exception a refusal is in Python. */
+fault fault_of(sv::refusal_kind k) {
+  switch (k) {
+    case sv::refusal_kind::usage: return fault::usage;
+    case sv::refusal_kind::limit: return fault::limit;
+    case sv::refusal_kind::timeout: return fault::timeout;
+    case sv::refusal_kind::board:
+    case sv::refusal_kind::line: break;
+  }
+  return fault::refused;
+}
+}  // namespace
+
 std::string python_words(std::string text) {
   static constexpr std::pair<std::string_view, std::string_view> words[] = {
       {"rcb4 motion buttons set", "set_button()"},
@@ -65,23 +75,20 @@ std::string python_words(std::string text) {
       {"--baud", "baud"},
   };
   for (const auto& [tool, py] : words)
-    for (auto at = text.find(tool); at != std::string::npos; at = text.find(tool, at + py.size()))
-      text.replace(at, tool.size(), py);
+    for (auto at = text.find(tool); at != std::string::npos; at = text.find(tool, at + 1)) {
+      // A method's number given in the text goes inside its parentheses: "rcb4 motion show 70".
+      std::size_t end = at + tool.size(), digits = 0;
+      while (end + 1 + digits < text.size() && std::isdigit(static_cast<unsigned char>(text[end + 1 + digits])))
+        ++digits;
+      if (py.ends_with("()") && digits > 0 && text[end] == ' ') {
+        const auto n = text.substr(end + 1, digits);
+        text.replace(at, end + 1 + digits - at, std::string(py.substr(0, py.size() - 1)) + n + ")");
+      } else {
+        text.replace(at, tool.size(), py);
+      }
+    }
   return text;
 }
-
-/** The exception a refusal is in Python. */
-fault fault_of(sv::refusal_kind k) {
-  switch (k) {
-    case sv::refusal_kind::usage: return fault::usage;
-    case sv::refusal_kind::limit: return fault::limit;
-    case sv::refusal_kind::timeout: return fault::timeout;
-    case sv::refusal_kind::board:
-    case sv::refusal_kind::line: break;
-  }
-  return fault::refused;
-}
-}  // namespace
 
 template <class F>
 auto board::service(const char* what, F&& f) {

@@ -66,7 +66,7 @@ py::dict config_dict(const rcb4::config_word& c) {
 py::dict status_dict(const motion_status& s) {
   return py::dict("running"_a = s.running, "suspended"_a = s.suspended,
                   "motion"_a = s.motion ? py::object(py::int_(*s.motion)) : py::object(py::none()),
-                  "program_counter"_a = s.program_counter);
+                  "program_counter"_a = s.program_counter, "program_on"_a = s.program_on);
 }
 
 /** The slot names kept for @p b's robot (a names file that does not read: UsageError). */
@@ -332,7 +332,8 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             const motion_status st = unlocked([&] { return b.motion(); });
             return status_dict(st);
           },
-          "Whether a motion runs: running, suspended, motion (or None), program_counter.")
+          "Whether a motion runs: running, suspended, motion (or None), program_counter, program_on (the ROM program "
+          "runs: off after stop_motion() or rom_restore(), when buttons play nothing until resume_motion()).")
       .def(
           "wait_motion",
           [](board& b, double timeout) {

@@ -112,9 +112,20 @@ def test_play_refuses_a_broken_slot(board, tmp_path):
     board.push_motion([{"pose": {"head_yaw": 15}, "time_ms": 150}, "end"], 80, backup=tmp_path / "80.bin")
     first = board.read(slot(80), 1, memory="rom")[0]
     board.write(slot(80) + first, bytes.fromhex("07 0B 00 00 00 00 00"), memory="rom")  # a bad checksum
-    with pytest.raises(pyrcb4.BoardRefused, match="is broken"):
+    with pytest.raises(pyrcb4.BoardRefused, match="is broken") as e:
         board.play_motion(80)
+    assert "show_motion(80) lists its code" in str(e.value) and "rcb4" not in str(e.value)
     assert not board.motion_status()["running"]
+
+
+def test_rom_restore_without_its_crc_says_what_to_do(board, tmp_path):
+    image = tmp_path / "image.bin"
+    image.write_bytes(b"\xff" * 262144)
+    with pytest.raises(pyrcb4.UsageError) as e:
+        board.rom_restore(image)
+    text = str(e.value)
+    assert text.startswith("rom_restore: ") and "image.bin.crc32 is missing" in text and "no_check=True" in text
+    assert "FILE" not in text and "--" not in text
 
 
 def test_a_loop_plays_and_a_caller_of_an_erased_slot_does_not(board, tmp_path):

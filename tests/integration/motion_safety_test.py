@@ -255,6 +255,12 @@ with serve() as dev:
     check(rc == 0 and "the button table the board compares (RAM) now is the restored one" in out
           and b.get("same") is True and "down+s2" in ram,
           f"rom restore: RAM's table is the restored one, RAM and ROM the same ({rc}: {out.strip()!r} {ram} {b.get('same')})")
+    # A restore leaves the ROM program off: status says so (buttons would play nothing).
+    rc, out, err = run(*on, "motion", "status")
+    check(rc == 0 and "the ROM program is off" in out and status(on).get("program_on") is False,
+          f"motion status after a restore: the ROM program is off ({rc}: {out.strip()!r})")
+    run(*on, "motion", "resume")
+    check(status(on).get("program_on") is True, "motion resume lets it run")
     rc, out, err = run(*on, "motion", "buttons", "clear", "s2+down")
     rc2, b, _ = run("--json", *on, "motion", "buttons")
     b = json.loads(b) if rc2 == 0 else {}
@@ -272,6 +278,15 @@ with serve() as dev:
     b2 = json.loads(b2) if rc3 == 0 else {}
     check("s3" in listed and rc == 0 and "s3" not in [e["buttons"] for e in b2.get("ram", {}).get("entries", [])],
           f"an entry only RAM holds is cleared ({listed} {rc}: {err.strip()!r} {b2.get('ram')})")
+    # ROM's table damaged after its first entry: the listing shows the entry and then the problem.
+    run(*on, "motion", "buttons", "set", "s3", "1")
+    run(*on, "motion", "buttons", "set", "s4", "2")
+    run(*on, "write", "rom", "0x0923", "FF " * 8)
+    rc, out, err = run(*on, "motion", "buttons")
+    rom_part = out.split("ROM (what the board loads at power-on) differs:")[-1]
+    check(rc == 0 and "then: " in rom_part and "buttons reset" in rom_part,
+          f"motion buttons shows a ROM table's problem after its entries ({rc}: {out.strip()!r})")
+    run(*on, "motion", "buttons", "reset")
     # Images that are no RCB-4 program.
     good = open("with-s2.bin", "rb").read()
     with_crc("erased.bin", b"\xff" * len(good))

@@ -88,14 +88,17 @@ int show(session& s, const motion_options& o, const globals& g) {
     return exit_ok;
   }
   fmt::print("buttons → motions (the vector-jump table at RAM 0x{:04X}; {} layout)\n", t.ram_at, layout.name);
-  for (const auto& e : t.ram.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
-  if (t.ram.entries.empty())
-    fmt::print("  no entries{}\n", t.ram.problem.empty() ? "" : fmt::format(": {}", t.ram.problem));
+  // A table's entries, then what is wrong with it (a table read only up to its problem).
+  const auto table = [&](const rcb4::motion::vector_table& v) {
+    for (const auto& e : v.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
+    if (v.entries.empty()) fmt::print("  no entries{}\n", v.problem.empty() ? "" : fmt::format(": {}", v.problem));
+    else if (!v.problem.empty())
+      fmt::print("  then: {} (rcb4 motion buttons reset writes an empty table)\n", v.problem);
+  };
+  table(t.ram);
   if (!t.same()) {
     fmt::print("ROM (what the board loads at power-on) differs:\n");
-    for (const auto& e : t.rom.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
-    if (t.rom.entries.empty())
-      fmt::print("  no entries{}\n", t.rom.problem.empty() ? "" : fmt::format(": {}", t.rom.problem));
+    table(t.rom);
   }
   if (!cfg.rom_program)
     fmt::print("the ROM program is off: no button plays anything until it runs (rcb4 motion resume)\n");

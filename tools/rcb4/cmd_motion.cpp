@@ -61,6 +61,7 @@ json state_json(const rcb4::ops::motion_state& st) {
   json j;
   j["running"] = st.running;
   j["suspended"] = st.suspended;
+  j["program_on"] = st.program_on;
   j["motion"] = st.motion ? json(*st.motion) : json(nullptr);
   j["program_counter"] = st.program_counter;
   return j;
@@ -72,6 +73,11 @@ std::string state_text(const rcb4::ops::motion_state& st) {
         "{} stopped part way (program counter 0x{:06X}; the ROM program is off: rcb4 motion resume "
         "continues it)",
         st.motion ? fmt::format("motion {}", *st.motion) : std::string("a program"), st.program_counter);
+  if (!st.running && !st.program_on)
+    return fmt::format(
+        "no motion running (program counter 0x{:06X}); the ROM program is off, so buttons play nothing: rcb4 "
+        "motion resume lets it run",
+        st.program_counter);
   if (!st.running) return fmt::format("no motion running (program counter 0x{:06X})", st.program_counter);
   if (st.motion) return fmt::format("motion {} running (program counter 0x{:06X})", *st.motion, st.program_counter);
   return fmt::format("a program is running outside the motion slots (program counter 0x{:06X})", st.program_counter);

@@ -124,6 +124,7 @@ struct motion_state {
   std::optional<unsigned> motion;     ///< its number under the layout, when the PC is in a motion slot
   std::uint32_t program_counter = 0;  ///< where the ROM program is
   unsigned depth = 0;                 ///< the call stack's depth (RAM 0x0005): CALLs pending, the play's own included
+  bool program_on = true;  ///< the ROM program runs (config bit 1): off after motion stop or a ROM restore, buttons play nothing
   friend bool operator==(const motion_state&, const motion_state&) = default;
 };
 
@@ -152,6 +153,7 @@ class read_motion_state {
     state_.program_counter = b[0] | (std::uint32_t{b[1]} << 8) | (std::uint32_t{b[2]} << 16);
     const bool pending = (b[3] | b[4] | b[5] | b[6] | b[7]) != 0;  // SP, unused, first update flags
     state_.depth = b[3];
+    state_.program_on = program_on;
     state_.running = pending && program_on;
     state_.suspended = pending && !program_on;
     const std::uint32_t base = layout_.motion_base.value();

@@ -65,18 +65,18 @@ void save_rom_image(const std::string& path, std::span<const std::uint8_t> image
 std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    throw refused(refusal_kind::usage, fmt::format("FILE: {} is not a regular file", path));
+    throw refused(refusal_kind::usage, fmt::format("{} is not a regular file", path));
   if (const auto size = std::filesystem::file_size(path, ec); !ec && size != rom_size)
-    throw refused(refusal_kind::usage, fmt::format("FILE: {} holds {} bytes; a ROM image is {} (rcb4 rom backup "
+    throw refused(refusal_kind::usage, fmt::format("{} holds {} bytes; a ROM image is {} (rcb4 rom backup "
                                                    "makes one)",
                                                    path, size, rom_size));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw refused(refusal_kind::usage, fmt::format("FILE: {} cannot be read ({})", path, std::strerror(errno)));
+  if (!in) throw refused(refusal_kind::usage, fmt::format("{} cannot be read ({})", path, std::strerror(errno)));
   std::vector<std::uint8_t> image(rom_size + 1);
   in.read(reinterpret_cast<char*>(image.data()), static_cast<std::streamsize>(image.size()));
   image.resize(static_cast<std::size_t>(in.gcount()));
   if (image.size() != rom_size)
-    throw refused(refusal_kind::usage, fmt::format("FILE: {} holds {} bytes; a ROM image is {} (rcb4 rom backup "
+    throw refused(refusal_kind::usage, fmt::format("{} holds {} bytes; a ROM image is {} (rcb4 rom backup "
                                                    "makes one)",
                                                    path, image.size(), rom_size));
   std::ifstream sum(path + ".crc32");
@@ -84,13 +84,15 @@ std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check)
   if (!(sum >> word)) {
     if (no_check) return image;
     throw refused(refusal_kind::usage,
-                  fmt::format("FILE: {}.crc32 is missing or empty: the image cannot be checked", path));
+                  fmt::format("{}.crc32 is missing or empty: the image cannot be checked", path),
+                  "rcb4 rom backup writes it beside the image; --no-check restores one without it (its plausibility "
+                  "is still checked)");
   }
   const auto want = fmt::format("{:08x}", crc32(image));
   if (word != want)
     throw refused(
         refusal_kind::usage,
-        fmt::format("FILE: {} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
+        fmt::format("{} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
         fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
                     "delete {}.crc32 and restore with --no-check",
                     path, path));
