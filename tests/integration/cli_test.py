@@ -560,5 +560,19 @@ check("expected JOINT DEGREES" in hand.stderr.readline(), "--hand: a line that n
 hand.stdin.close()
 hand.terminate()
 check(hand.wait(timeout=10) == 0, "serve --hand ends on SIGTERM with 0")
+# From a named pipe, as docs/virtual-board.md shows: one echo after another is read.
+with tempfile.TemporaryDirectory() as d:
+    fifo = os.path.join(d, "hand")
+    os.mkfifo(fifo)
+    hand = subprocess.Popen(f'exec "{RCB4}" serve --pty --hand < "{fifo}"', shell=True, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, bufsize=1)
+    for deg in (10, 20):
+        with open(fifo, "w") as w:
+            w.write(f"left_knee {deg}\n")
+    lines = [hand.stderr.readline() for _ in range(2)]
+    check(all("left_knee: its servo holds its position" in x for x in lines),
+          f"--hand from a named pipe answers each writer's line ({lines!r})")
+    hand.terminate()
+    check(hand.wait(timeout=10) == 0, "and ends on SIGTERM with 0")
 
 finish()

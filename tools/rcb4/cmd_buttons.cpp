@@ -91,7 +91,8 @@ int show(session& s, const motion_options& o, const globals& g) {
   // A table's entries, then what is wrong with it (a table read only up to its problem).
   const auto table = [&](const rcb4::motion::vector_table& v) {
     for (const auto& e : v.entries) fmt::print("  {}\n", entry_text(e, layout, robot));
-    if (v.entries.empty()) fmt::print("  no entries{}\n", v.problem.empty() ? "" : fmt::format(": {}", v.problem));
+    if (v.entries.empty())
+      fmt::print("  no entries{}\n", v.problem.empty() ? "" : fmt::format(": {}", v.problem));
     else if (!v.problem.empty())
       fmt::print("  then: {} (rcb4 motion buttons reset writes an empty table)\n", v.problem);
   };

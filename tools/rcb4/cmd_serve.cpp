@@ -4,6 +4,8 @@
 
 #include <boost/asio.hpp>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -199,7 +201,12 @@ int serve(serve_options& o, const globals& g) {
     });
   };
   if (o.hand) {
-    input.assign(::dup(STDIN_FILENO));
+    // A named pipe is held open for writing too, so each `echo ... > hand` is read: without a
+    // writer of our own, the first writer's close would end the input.
+    struct stat st {};
+    const int fd =
+        ::fstat(STDIN_FILENO, &st) == 0 && S_ISFIFO(st.st_mode) ? ::open("/proc/self/fd/0", O_RDWR | O_CLOEXEC) : -1;
+    input.assign(fd >= 0 ? fd : ::dup(STDIN_FILENO));
     read_line();
   }
   boost::asio::signal_set signals(io, SIGINT, SIGTERM, SIGHUP);
