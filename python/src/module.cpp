@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <map>
 
+#include <rcb4/robot/urdf.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
@@ -220,6 +221,18 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             return d;
           },
           "Each joint's (lower, upper) limit in degrees, from the profile: what move() and write() enforce.")
+      .def(
+          "urdf",
+          [](const board& b, const std::string& prefix) {
+            try {
+              return rcb4::robot::to_urdf(b.robot(), {.prefix = prefix});
+            } catch (const rcb4::robot::profile_error& e) {
+              throw board_error(fault::usage, std::string("urdf: ") + e.what());
+            }
+          },
+          "prefix"_a = "",
+          "The robot as URDF (as rcb4 urdf writes it: joint names with prefix, limits, axes, simple geometry), for "
+          "robot_description; UsageError when the profile has no kinematics.")
       .def_property_readonly(
           "period",
           [](board& b) {

@@ -18,6 +18,7 @@ from std_srvs.srv import Trigger, TriggerResponse
 from trajectory_msgs.msg import JointTrajectory
 
 import pyrcb4
+from rcb4_ros import actions
 
 
 class Rcb4Node:
@@ -62,6 +63,9 @@ class Rcb4Node:
         self.stream = None             # (targets in degrees, received) from ~joint_command
         self.freed = numpy.zeros(len(self.names), dtype=bool)  # freed joints: no command powers them again
         self.halt = False              # stop: every joint under way holds where it is, at the next cycle
+        self.generation = 0            # counts what replaced the trajectory (a new one, a stop): actions watch it
+        self.replaced_by = ""          # why the last trajectory ended early
+        self.moves = {}                # joint index -> (t0, from, to, t1) degrees: the move the board makes now
         self.refused_at = {}           # refusal text -> when it was last logged (repeats once a second)
         self.link_ok, self.link_reason = True, ""
         self.cycles, self.errors, self.timeouts = 0, 0, 0
@@ -85,6 +89,20 @@ class Rcb4Node:
         rospy.Service("~resume_motion", Trigger, lambda r: self.trigger("resume", None))
         rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.where, len(self.names),
                       self.rate, self.period * 1000)
+        self.describe_robot()
+        self.actions = actions.start(self)
+
+    def describe_robot(self):
+        """robot_description from the profile's kinematics (rcb4 urdf), unless one is set already."""
+        if not rospy.get_param("~robot_description", True):
+            return
+        if rospy.has_param("robot_description"):
+            rospy.loginfo("rcb4: robot_description is set already: left as it is")
+            return
+        try:
+            rospy.set_param("robot_description", self.board.urdf(self.prefix))
+        except pyrcb4.UsageError as e:
+            rospy.logwarn("rcb4: no robot_description: %s", e)
 
     # --- callbacks: check, queue, never touch the line ----------------------------------------------
     def degrees_of(self, names, positions, what):
@@ -117,35 +135,48 @@ class Rcb4Node:
             if len(self.refused_at) > 100:  # forget the old ones
                 self.refused_at = {k: v for k, v in self.refused_at.items() if now - v < 1.0}
 
-    def stop_now(self):
+    def stop_now(self, why="stopped (~stop, an empty trajectory or a cancel): the joints hold where they are"):
         """Stop: what is under way is dropped and every joint that moves holds where it is now."""
         with self.lock:
             self.trajectory = []
             self.stream = None
             self.halt = True
+            self.generation += 1
+            self.replaced_by = why
+
+    def move_refusal(self):
+        """Why a move would fight a ROM motion now (the one rule, through pyrcb4), or None."""
+        return pyrcb4.move_refusal(self.last_motion or {})
+
+    def follow(self, names, points, stamp=0.0):
+        """Replaces what is under way by the trajectory @p points [(time_from_start s, positions rad)]
+        of joints @p names, from @p stamp (ROS time; 0: now); ValueError when a point does not check.
+        Returns its generation (it changes when something else replaces or stops it)."""
+        moves, last = [], 0.0
+        before = self.angles.copy()  # where the first segment starts: the joints as last read
+        for k, (t, positions) in enumerate(points):
+            targets = self.degrees_of(names, positions, f"point {k}")
+            if t < last:
+                raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
+            moves += self.segment(last, t, before, targets)
+            before, last = targets, t
+        begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
+        with self.lock:  # a newer trajectory replaces what is left of the old one
+            self.trajectory = [(begin + at, targets, frames) for at, targets, frames in moves]
+            self.stream = None
+            self.generation += 1
+            self.replaced_by = "replaced by a newer trajectory or command"
+            return self.generation
 
     def on_trajectory(self, msg):
         if not msg.points:  # an empty trajectory: stop, every joint holds where it is now
             self.stop_now()
             return
+        stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
         try:
-            points, last = [], 0.0
-            before = self.angles.copy()  # where the first segment starts: the joints as last read
-            for k, p in enumerate(msg.points):
-                targets = self.degrees_of(msg.joint_names, p.positions, f"point {k}")
-                t = p.time_from_start.to_sec()
-                if t < last:
-                    raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
-                points += self.segment(last, t, before, targets)
-                before, last = targets, t
+            self.follow(msg.joint_names, [(p.time_from_start.to_sec(), p.positions) for p in msg.points], stamp)
         except ValueError as e:
             self.refuse(f"trajectory refused, nothing moves: {e}")
-            return
-        stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
-        begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
-        with self.lock:  # a newer trajectory replaces what is left of the old one
-            self.trajectory = [(begin + at, targets, frames) for at, targets, frames in points]
-            self.stream = None
 
     def segment(self, t0, t1, before, targets):
         """The moves that take the joints from @p before (degrees at t0) to @p targets at t1:
@@ -171,6 +202,8 @@ class Rcb4Node:
             return
         with self.lock:
             self.stream = targets
+            self.generation += 1
+            self.replaced_by = "replaced by a joint_command"
             # The joints it names leave the trajectory under way; the others go on with it.
             named = ~numpy.isnan(targets)
             rest = []
@@ -191,13 +224,17 @@ class Rcb4Node:
     def queue(self, what, argument, reply=None):
         self.requests.put((what, argument, reply))
 
-    def trigger(self, what, argument):
+    def ask(self, what, argument, timeout=2.0):
+        """Has the loop thread do @p what and waits for it: (ok, message)."""
         done = threading.Event()
         result = {}
         self.queue(what, argument, (done, result))
-        if not done.wait(2.0):
-            return TriggerResponse(False, "the board did not answer in 2 s")
-        return TriggerResponse(result.get("ok", False), result.get("message", ""))
+        if not done.wait(timeout):
+            return False, f"the board did not answer in {timeout:g} s"
+        return result.get("ok", False), result.get("message", "")
+
+    def trigger(self, what, argument):
+        return TriggerResponse(*self.ask(what, argument))
 
     # --- the loop: the only thread on the line ------------------------------------------------------
     def carry_out(self):
@@ -214,6 +251,7 @@ class Rcb4Node:
                     done = (self.board.free if what == "free" else self.board.hold)(*names)
                     for n in done:
                         self.freed[self.names.index(n)] = what == "free"
+                        self.moves.pop(self.names.index(n), None)
                     # What was under way for a freed joint is dropped (this thread writes nothing in
                     # between): its next point would power the joint again.
                     dropped = self.drop([self.names.index(n) for n in done]) if what == "free" else []
@@ -233,12 +271,46 @@ class Rcb4Node:
                 elif what == "stop":
                     self.board.stop_motion()
                     message = "motion stopped"
+                elif what == "stretch":
+                    value, names = argument
+                    done = self.board.stretch(value, *[self.unprefixed(n) for n in names])
+                    message = f"stretch {value}: {len(done)} joints"
+                elif what == "adjust":
+                    message = self.adjust(argument)
             except pyrcb4.Error as e:
                 ok, message = False, str(e) if str(e).startswith(what + ":") else f"{what}: {e}"
                 rospy.logerr("rcb4: %s", message)
             if reply:
                 reply[1].update(ok=ok, message=message)
                 reply[0].set()
+
+    def unprefixed(self, name):
+        return name[len(self.prefix):] if self.prefix and name.startswith(self.prefix) else name
+
+    def reference(self, i, now):
+        """Where joint @p i is meant to be at @p now, as the board interpolates its move (NaN: unknown)."""
+        m = self.moves.get(i)
+        if m is None:
+            return math.nan
+        t0, a, b, t1 = m
+        return b if now >= t1 or t1 <= t0 else a + (b - a) * (now - t0) / (t1 - t0)
+
+    def adjust(self, thresholds):
+        """kxr_controller's AdjustAngleVector: a held joint further than its threshold (degrees) from
+        where it is meant to be now holds where it is."""
+        now = time.monotonic()
+        over = []
+        for name, limit in thresholds:
+            i = self.index[name]
+            error = abs(self.reference(i, now) - self.angles[i])
+            if not self.freed[i] and error > limit:  # NaN (no move known, not measured) is not over
+                over.append((i, error, limit))
+        if not over:
+            return "no joint is further from its reference than its threshold"
+        self.board.hold(*[self.names[i] for i, _, _ in over])
+        for i, _, _ in over:
+            self.moves.pop(i, None)
+        return "held " + ", ".join(f"{self.prefix + self.names[i]} ({e:.1f} deg > {lim:g})" for i, e, lim in over)
 
     def drop(self, indices):
         """Drops what is under way (trajectory, stream) for the joints at @p indices; their names."""
@@ -266,6 +338,7 @@ class Rcb4Node:
         held = [n for n, f in zip(self.names, self.freed) if not f]
         if held:
             self.board.hold(*held)
+        self.moves.clear()
 
     def without_freed(self, targets, what):
         """@p targets with the freed joints left out (a position would power them again), said once."""
@@ -296,6 +369,8 @@ class Rcb4Node:
             self.refuse(f"{refusal} (~stop_motion first)")
             with self.lock:
                 self.trajectory = []
+                self.generation += 1
+                self.replaced_by = f"{refusal} (~stop_motion first)"
             return
         if due:
             due = (due[0], self.without_freed(due[1], "trajectory"), due[2])
@@ -312,8 +387,20 @@ class Rcb4Node:
             if frames > 0:
                 frames = max(1, round((at + frames * self.period - now) / self.period))
             self.loop.write(targets, frames=frames)
+            self.moved(targets, frames, now)
         elif stream is not None:
-            self.loop.write(stream, frames=max(1, round(1.0 / self.rate / self.period)))
+            frames = max(1, round(1.0 / self.rate / self.period))
+            self.loop.write(stream, frames=frames)
+            self.moved(stream, frames, now)
+
+    def moved(self, targets, frames, now):
+        """Keeps the moves just sent (for AdjustAngleVector's reference)."""
+        for i in numpy.flatnonzero(~numpy.isnan(targets)):
+            i = int(i)
+            start = self.reference(i, now)
+            if math.isnan(start):
+                start = self.angles[i]
+            self.moves[i] = (now, start, float(targets[i]), now + frames * self.period)
 
     def cycle(self):
         self.carry_out()

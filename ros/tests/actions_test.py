@@ -1,0 +1,280 @@
+#!/usr/bin/env python3
+# rcb4_ros as a kxr_controller user meets it, against a real ROS master: an actionlib client of
+# control_msgs/FollowJointTrajectory on /fullbody_controller/follow_joint_trajectory (success within
+# tolerance, INVALID_JOINTS and INVALID_GOAL with nothing moved, cancel and preemption holding the
+# joints, a ROM motion refusing the goal), kxr_controller's ServoOnOff, Stretch and
+# AdjustAngleVector, the joints parameter and robot_description; on a board of our own whose
+# servos never move, PATH_TOLERANCE_VIOLATED and an adjustment; a script written as a
+# kxr_controller user writes it, run unchanged.
+#   actions_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR MESSAGES_DIR
+# SPDX-License-Identifier: BSL-1.0
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import textwrap
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "tests", "integration")]
+from checks import check, finish  # noqa: E402
+import master as rosmaster  # noqa: E402
+from standin import StandIn  # noqa: E402
+
+RCB4, PYRCB4, NODE_SRC, MESSAGES = sys.argv[1:5]
+NODE = os.path.join(NODE_SRC, "..", "scripts", "rcb4_node")
+master, env = rosmaster.start(PYRCB4, NODE_SRC, name="/rcb4_actions_test")
+env["RCB4_ROS_MESSAGES"] = MESSAGES
+sys.path.append(MESSAGES)
+
+import actionlib  # noqa: E402
+import rospy  # noqa: E402
+from actionlib_msgs.msg import GoalStatus  # noqa: E402
+from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryGoal, JointTolerance  # noqa: E402
+from control_msgs.msg import FollowJointTrajectoryResult as Result  # noqa: E402
+from kxr_controller.msg import AdjustAngleVectorAction, AdjustAngleVectorGoal  # noqa: E402
+from kxr_controller.msg import ServoOnOffAction, ServoOnOffGoal, Stretch, StretchAction, StretchGoal  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import UInt8  # noqa: E402
+from trajectory_msgs.msg import JointTrajectoryPoint  # noqa: E402
+
+rospy.init_node("rcb4_actions_test", anonymous=True, disable_signals=True)
+states = []
+rospy.Subscriber("/joint_states", JointState, lambda m: states.append(m), queue_size=100)
+
+
+def wait_for(pred, timeout=10):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        v = pred()
+        if v:
+            return v
+        time.sleep(0.05)
+    return None
+
+
+def position(name):
+    for m in reversed(states[-20:]):
+        if name in m.name:
+            return math.degrees(m.position[m.name.index(name)])
+    return None
+
+
+def goal(points, joints=("left_knee",), path=(), end=(), goal_time=0.0):
+    g = FollowJointTrajectoryGoal()
+    g.trajectory.joint_names = list(joints)
+    for degs, secs in points:
+        degs = degs if isinstance(degs, (list, tuple)) else [degs]
+        g.trajectory.points.append(JointTrajectoryPoint(positions=[math.radians(d) for d in degs],
+                                                        time_from_start=rospy.Duration(secs)))
+    g.path_tolerance = [JointTolerance(name=n, position=math.radians(d)) for n, d in path]
+    g.goal_tolerance = [JointTolerance(name=n, position=math.radians(d)) for n, d in end]
+    g.goal_time_tolerance = rospy.Duration(goal_time)
+    return g
+
+
+def start_node(*params):
+    rospy.delete_param("/robot_description") if rospy.has_param("/robot_description") else None
+    return subprocess.Popen([sys.executable, NODE, *params], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
+
+
+def stop(node):
+    node.send_signal(signal.SIGINT)
+    try:
+        node.wait(timeout=5)
+    except subprocess.TimeoutExpired:
+        node.kill()
+        node.wait()
+    return node.stdout.read()
+
+
+def tool_joints(dev):
+    r = subprocess.run([RCB4, "--json", "--device", dev, "joint", "list"], capture_output=True, text=True, timeout=30)
+    return {j["name"]: j for j in json.loads(r.stdout)} if r.returncode == 0 else {}
+
+
+srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+node = start_node(f"_device:={dev}", "_rate:=50")
+try:
+    client = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+    check(client.wait_for_server(rospy.Duration(20)), "the FollowJointTrajectory server is up")
+    joints = rospy.get_param("/fullbody_controller/joints", [])
+    check(len(joints) == 20 and "left_knee" in joints, f"fullbody_controller/joints: the 20 joints ({len(joints)})")
+    urdf = rospy.get_param("/robot_description", "")
+    check('<robot name="' in urdf and 'joint name="left_knee"' in urdf, "robot_description: the profile's URDF")
+    wait_for(lambda: position("left_knee") is not None)
+
+    # The issue's check: left_knee to 40 deg over 1 s, SUCCEEDED, joint_states within 1 deg.
+    feedback = []
+    client.send_goal(goal([(40, 1.0)]), feedback_cb=feedback.append)
+    done = client.wait_for_result(rospy.Duration(10))
+    r = client.get_result()
+    check(done and client.get_state() == GoalStatus.SUCCEEDED and r.error_code == Result.SUCCESSFUL,
+          f"a two-second goal succeeds ({client.get_state()}, {r and r.error_string!r})")
+    time.sleep(0.2)
+    check(abs(position("left_knee") - 40) < 1, f"joint_states: left_knee within 1 deg of 40 ({position('left_knee')})")
+    check(len(feedback) > 20 and feedback[-1].joint_names == ["left_knee"]
+          and abs(math.degrees(feedback[len(feedback) // 2].desired.positions[0]) - 20) < 8,
+          f"feedback at the control rate: desired, actual, error ({len(feedback)} messages)")
+    # Two joints, two points.
+    client.send_goal(goal([([10, 20], 0.4), ([-10, 0], 0.8)], joints=("left_knee", "head_yaw")))
+    client.wait_for_result(rospy.Duration(10))
+    check(client.get_state() == GoalStatus.SUCCEEDED and abs(position("left_knee") + 10) < 1
+          and abs(position("head_yaw")) < 1, f"a two-point goal of two joints succeeds ({client.get_state()})")
+
+    # Refused goals: nothing moves.
+    for g, code, what in ((goal([(20, 1.0)], joints=("no_such_joint",)), Result.INVALID_JOINTS, "an unknown joint"),
+                          (goal([(20, 1.0)], joints=("left_knee", "left_knee")), Result.INVALID_JOINTS, "a joint twice"),
+                          (goal([(140, 1.0)]), Result.INVALID_GOAL, "a point beyond the limit"),
+                          (goal([(20, 1.0), (30, 0.5)]), Result.INVALID_GOAL, "times that go back"),
+                          (goal([(float("nan"), 1.0)]), Result.INVALID_GOAL, "NaN")):
+        client.send_goal(g)
+        client.wait_for_result(rospy.Duration(5))
+        r = client.get_result()
+        time.sleep(0.3)
+        check(client.get_state() == GoalStatus.ABORTED and r.error_code == code and abs(position("left_knee") + 10) < 0.5,
+              f"{what}: {code}, nothing moves ({client.get_state()}, {r.error_code}: {r.error_string!r})")
+
+    # Cancel mid-way: the joint holds where it is.
+    client.send_goal(goal([(-60, 2.0)]))
+    time.sleep(0.8)
+    client.cancel_goal()
+    client.wait_for_result(rospy.Duration(5))
+    time.sleep(0.2)
+    at = position("left_knee")
+    time.sleep(1.5)
+    check(client.get_state() == GoalStatus.PREEMPTED and -50 < at < -12 and abs(position("left_knee") - at) < 1,
+          f"cancel mid-way: PREEMPTED, left_knee holds at {at:.1f} (now {position('left_knee'):.1f}), not -60")
+    # A new goal preempts the one under way.
+    first = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+    first.wait_for_server(rospy.Duration(5))
+    first.send_goal(goal([(60, 2.0)], joints=("head_yaw",)))
+    time.sleep(0.5)
+    client.send_goal(goal([(0, 0.5)], joints=("head_yaw",)))
+    client.wait_for_result(rospy.Duration(5))
+    first.wait_for_result(rospy.Duration(5))
+    check(first.get_state() == GoalStatus.PREEMPTED and client.get_state() == GoalStatus.SUCCEEDED
+          and abs(position("head_yaw")) < 1, f"a newer goal preempts: ({first.get_state()}, {client.get_state()})")
+
+    # A ROM motion running refuses the goal, as the topic does.
+    play = rospy.Publisher("/rcb4/play_motion", UInt8, queue_size=2)
+    wait_for(lambda: play.get_num_connections() > 0)
+    play.publish(UInt8(3))
+    time.sleep(0.5)
+    client.send_goal(goal([(30, 0.5)], joints=("head_yaw",)))
+    client.wait_for_result(rospy.Duration(5))
+    r = client.get_result()
+    check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.INVALID_GOAL and "motion 3" in r.error_string,
+          f"a goal while motion 3 runs: refused ({r.error_string!r})")
+    time.sleep(3.0)
+
+    # kxr_controller's servo actions.
+    on_off = actionlib.SimpleActionClient("/fullbody_controller/servo_on_off_real_interface", ServoOnOffAction)
+    check(on_off.wait_for_server(rospy.Duration(5)), "the ServoOnOff server is up")
+    on_off.send_goal(ServoOnOffGoal(joint_names=["left_knee"], servo_on_states=[False]))
+    on_off.wait_for_result(rospy.Duration(5))
+    check(on_off.get_state() == GoalStatus.SUCCEEDED, f"ServoOnOff frees left_knee ({on_off.get_goal_status_text()!r})")
+    on_off.send_goal(ServoOnOffGoal(joint_names=["no_such_joint"], servo_on_states=[True]))
+    on_off.wait_for_result(rospy.Duration(5))
+    check(on_off.get_state() == GoalStatus.ABORTED and "no_such_joint" in on_off.get_goal_status_text(),
+          f"ServoOnOff of an unknown joint: aborted, named ({on_off.get_goal_status_text()!r})")
+    # A goal naming the freed joint moves the others and leaves it free, as kxr_controller does.
+    knee = position("left_knee")
+    client.send_goal(goal([([knee + 30, 20], 0.5)], joints=("left_knee", "head_yaw")))
+    client.wait_for_result(rospy.Duration(5))
+    check(client.get_state() == GoalStatus.SUCCEEDED and abs(position("head_yaw") - 20) < 1
+          and abs(position("left_knee") - knee) < 1, f"a goal naming a freed joint leaves it out ({position('left_knee')})")
+
+    stretch = actionlib.SimpleActionClient("/fullbody_controller/stretch_interface", StretchAction)
+    check(stretch.wait_for_server(rospy.Duration(5)), "the Stretch server is up")
+    stretch.send_goal(StretchGoal(joint_names=["head_yaw"], stretch=60))
+    stretch.wait_for_result(rospy.Duration(5))
+    said = rospy.wait_for_message("/fullbody_controller/stretch", Stretch, timeout=5)
+    check(stretch.get_state() == GoalStatus.SUCCEEDED and said.joint_names == ["head_yaw"] and list(said.stretch) == [60],
+          f"Stretch 60 on head_yaw, said on fullbody_controller/stretch ({said})")
+    stretch.send_goal(StretchGoal(joint_names=[], stretch=200))
+    stretch.wait_for_result(rospy.Duration(5))
+    check(stretch.get_state() == GoalStatus.ABORTED and "1-127" in stretch.get_goal_status_text(),
+          f"Stretch 200: aborted ({stretch.get_goal_status_text()!r})")
+    adjust = actionlib.SimpleActionClient("/fullbody_controller/adjust_angle_vector_interface", AdjustAngleVectorAction)
+    check(adjust.wait_for_server(rospy.Duration(5)), "the AdjustAngleVector server is up")
+    adjust.send_goal(AdjustAngleVectorGoal(joint_names=["head_yaw"], error_threshold=[5.0]))
+    adjust.wait_for_result(rospy.Duration(5))
+    check(adjust.get_state() == GoalStatus.SUCCEEDED and "no joint" in adjust.get_goal_status_text(),
+          f"AdjustAngleVector with the joints on their way: nothing held ({adjust.get_goal_status_text()!r})")
+
+    # A script as a kxr_controller user writes it, unchanged.
+    script = os.path.join(tempfile.mkdtemp(), "kxr_user.py")
+    with open(script, "w") as f:
+        f.write(textwrap.dedent("""\
+            import actionlib, rospy
+            import control_msgs.msg
+            from kxr_controller.msg import ServoOnOffAction, ServoOnOffGoal
+            from trajectory_msgs.msg import JointTrajectoryPoint
+            rospy.init_node("kxr_user", anonymous=True)
+            joints = rospy.get_param("/fullbody_controller/joints")
+            servo = actionlib.SimpleActionClient("/fullbody_controller/servo_on_off_real_interface", ServoOnOffAction)
+            servo.wait_for_server()
+            servo.send_goal_and_wait(ServoOnOffGoal(joint_names=joints, servo_on_states=[True] * len(joints)))
+            traj = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory",
+                                                control_msgs.msg.FollowJointTrajectoryAction)
+            traj.wait_for_server()
+            g = control_msgs.msg.FollowJointTrajectoryGoal()
+            g.trajectory.joint_names = joints
+            g.trajectory.points = [JointTrajectoryPoint(positions=[0.1] * len(joints), time_from_start=rospy.Duration(1.0))]
+            traj.send_goal_and_wait(g)
+            print("result", traj.get_state(), traj.get_result().error_code)
+            """))
+    r = subprocess.run([sys.executable, script], env=dict(env, PYTHONPATH=env["PYTHONPATH"] + os.pathsep + MESSAGES),
+                       capture_output=True, text=True, timeout=60)
+    check(r.returncode == 0 and "result 3 0" in r.stdout and abs(position("left_knee") - math.degrees(0.1)) < 1,
+          f"a kxr_controller user's script runs unchanged: every servo on, all joints to 0.1 rad ({r.stdout.strip()!r} "
+          f"{r.stderr.strip()[-300:]!r})")
+    on_off.send_goal(ServoOnOffGoal(joint_names=["left_knee"], servo_on_states=[False]))
+    on_off.wait_for_result(rospy.Duration(5))
+finally:
+    out = stop(node)
+j = tool_joints(dev)
+check(j.get("left_knee", {}).get("state") == "free", f"rcb4 joint list after the node: left_knee free ({j.get('left_knee')})")
+check("follow_joint_trajectory: refused, nothing moves: no joint is called 'no_such_joint'" in out,
+      "a refused goal is logged with its reason")
+srv.terminate()
+srv.wait(timeout=10)
+
+# A board whose servos never move (our stand-in answers every move and keeps its positions):
+# the path tolerance is violated, and AdjustAngleVector holds the joint that lags.
+board = StandIn()
+node = start_node(f"_device:={board.path}", "_baud:=115200", "_rate:=20")
+try:
+    client = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+    client.wait_for_server(rospy.Duration(20))
+    client.send_goal(goal([(30, 1.0)], joints=("head_yaw",), path=[("head_yaw", 5.0)]))
+    client.wait_for_result(rospy.Duration(10))
+    r = client.get_result()
+    check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.PATH_TOLERANCE_VIOLATED
+          and "head_yaw" in r.error_string, f"a servo that lags: PATH_TOLERANCE_VIOLATED ({r.error_string!r})")
+    client.send_goal(goal([(30, 0.3)], joints=("head_yaw",), end=[("head_yaw", 1.0)], goal_time=0.3))
+    client.wait_for_result(rospy.Duration(10))
+    r = client.get_result()
+    check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.GOAL_TOLERANCE_VIOLATED,
+          f"and it never arrives: GOAL_TOLERANCE_VIOLATED ({r.error_string!r})")
+    client.send_goal(goal([(30, 3.0)], joints=("head_yaw",)))
+    time.sleep(1.5)
+    adjust = actionlib.SimpleActionClient("/fullbody_controller/adjust_angle_vector_interface", AdjustAngleVectorAction)
+    adjust.wait_for_server(rospy.Duration(5))
+    adjust.send_goal(AdjustAngleVectorGoal(joint_names=["head_yaw"], error_threshold=[5.0]))
+    adjust.wait_for_result(rospy.Duration(5))
+    client.wait_for_result(rospy.Duration(5))
+    check(adjust.get_state() == GoalStatus.SUCCEEDED and "held head_yaw" in adjust.get_goal_status_text()
+          and client.get_state() in (GoalStatus.ABORTED, GoalStatus.PREEMPTED),
+          f"AdjustAngleVector holds the lagging joint and ends the goal ({adjust.get_goal_status_text()!r}, "
+          f"{client.get_state()})")
+finally:
+    stop(node)
+master.terminate()
+finish()
