@@ -7,9 +7,9 @@
 #include <cstdlib>
 #include <map>
 
-#include <rcb4/robot/urdf.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
+#include <rcb4/robot/urdf.hpp>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -221,6 +221,16 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             return d;
           },
           "Each joint's (lower, upper) limit in degrees, from the profile: what move() and write() enforce.")
+      .def_property_readonly(
+          "mimic_joints",
+          [](const board& b) {
+            py::dict d;
+            for (const auto& mj : b.robot().mimics())
+              d[py::str(mj.name)] = py::make_tuple(mj.joint, mj.multiplier, mj.offset);
+            return d;
+          },
+          "The profile's joints that follow another (URDF's mimic: no servo of their own): name -> (joint, "
+          "multiplier, offset in degrees); the angle is multiplier × the joint's + offset.")
       .def(
           "urdf",
           [](const board& b, const std::string& prefix) {

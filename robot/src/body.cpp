@@ -10,6 +10,7 @@
 #include <cctype>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "yaml_helpers.hpp"
 
@@ -175,11 +176,18 @@ std::string to_urdf(const model& m, const urdf_options& o) {
                        xml(o.prefix), xml(j.child));
     out += fmt::format("    <origin xyz=\"{}\" rpy=\"{}\"/>\n", metres(j.xyz), radians(j.rpy));
     if (!j.fixed) {
-      const auto* pj = m.find(j.name);
+      // A profile joint's limits; a mimic joint's are those of the joint it follows, carried over.
+      const auto* mj = m.find_mimic(j.name);
+      const auto* pj = m.find(mj ? mj->joint : j.name);
+      double lower = mj ? mj->angle(pj->lower) : pj->lower, upper = mj ? mj->angle(pj->upper) : pj->upper;
+      if (lower > upper) std::swap(lower, upper);
       const double len = std::sqrt(j.axis[0] * j.axis[0] + j.axis[1] * j.axis[1] + j.axis[2] * j.axis[2]);
       out += fmt::format("    <axis xyz=\"{:g} {:g} {:g}\"/>\n", j.axis[0] / len, j.axis[1] / len, j.axis[2] / len);
       out += fmt::format("    <limit lower=\"{:g}\" upper=\"{:g}\" effort=\"{:g}\" velocity=\"{:g}\"/>\n",
-                         pj->lower * pi / 180, pj->upper * pi / 180, o.effort, o.velocity);
+                         lower * pi / 180, upper * pi / 180, o.effort, o.velocity);
+      if (mj)
+        out += fmt::format("    <mimic joint=\"{}{}\" multiplier=\"{:g}\" offset=\"{:g}\"/>\n", xml(o.prefix),
+                           xml(mj->joint), mj->multiplier, mj->offset * pi / 180);
     }
     out += "  </joint>\n";
   }

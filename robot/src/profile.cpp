@@ -65,7 +65,7 @@ pose parse_pose(std::string_view text, const std::string& source, const model& m
 model parse_profile_nodes(std::string_view text, const std::string& source) {
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw profile_error(source, "a profile is a mapping with robot, joints, groups, motions");
-  check_keys(source, root, {"robot", "joints", "groups", "motions", "kinematics"}, "profile");
+  check_keys(source, root, {"robot", "joints", "groups", "motions", "mimic", "kinematics"}, "profile");
   const std::string name = root["robot"] ? scalar(source, root["robot"], "robot") : std::string("robot");
   const YAML::Node js = root["joints"];
   if (!js || !js.IsMap() || js.size() == 0)
@@ -108,6 +108,22 @@ model parse_profile_nodes(std::string_view text, const std::string& source) {
   auto m = model::make(name, std::move(joints), std::move(groups), std::move(motions));
   if (!ok(m)) throw profile_error(source, std::get<problem>(m).message);
   auto out = std::get<model>(std::move(m));
+  // mimic: NAME: {joint: J, multiplier: M, offset: DEG}: joints on another's servo (URDF's mimic).
+  if (const YAML::Node ms = root["mimic"]) {
+    if (!ms.IsMap()) fail(source, ms, "mimic: expected a mapping of joint names to {joint, multiplier, offset}");
+    for (const auto& kv : ms) {
+      mimic_joint mj;
+      mj.name = scalar(source, kv.first, "mimic joint name");
+      const auto& v = kv.second;
+      if (!v.IsMap() || !v["joint"]) fail(source, v, mj.name + ": expected {joint, multiplier, offset}");
+      check_keys(source, v, {"joint", "multiplier", "offset"}, mj.name);
+      mj.joint = scalar(source, v["joint"], mj.name + ": joint");
+      if (v["multiplier"]) mj.multiplier = number(source, v["multiplier"], mj.name + ": multiplier");
+      if (v["offset"]) mj.offset = number(source, v["offset"], mj.name + ": offset");
+      if (const auto p = out.add_mimic(mj)) fail(source, kv.first, p->message);
+      names.push_back(mj.name);
+    }
+  }
   if (const YAML::Node k = root["kinematics"]) {
     if (const auto p = out.attach_body(parse_body(source, k, names)))  // parse_body has checked it: never
       throw profile_error(source, "kinematics: " + p->message);

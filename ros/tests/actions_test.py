@@ -276,5 +276,38 @@ try:
           f"{client.get_state()})")
 finally:
     stop(node)
+# A robot whose URDF names its joints in upper case and has two joints on one servo (a gripper):
+# joint_states carries both, the follower as URDF's mimic says; it cannot be commanded itself.
+profile = os.path.join(tempfile.mkdtemp(), "gripper.yaml")
+with open(profile, "w") as f:
+    f.write("robot: gripper\njoints:\n  HEAD_JOINT0: {ics: 0, lower: -90, upper: 90}\n"
+            "  L_FINGER: {ics: 2, lower: 0, upper: 60}\nmimic:\n  R_FINGER: {joint: L_FINGER, multiplier: -1}\n")
+srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+states.clear()
+node = start_node(f"_device:={dev}", f"_robot:={profile}", "_rate:=50")
+try:
+    client = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+    client.wait_for_server(rospy.Duration(20))
+    wait_for(lambda: position("R_FINGER") is not None)
+    check(rospy.get_param("/fullbody_controller/joints", []) == ["HEAD_JOINT0", "L_FINGER"] and
+          position("HEAD_JOINT0") is not None, f"upper-case joint names ({states[-1].name if states else None})")
+    client.send_goal(goal([(30, 0.5)], joints=("L_FINGER",)))
+    client.wait_for_result(rospy.Duration(10))
+    time.sleep(0.2)
+    check(client.get_state() == GoalStatus.SUCCEEDED and abs(position("L_FINGER") - 30) < 1
+          and abs(position("R_FINGER") + 30) < 1,
+          f"a mimic joint in joint_states: R_FINGER = -1 x L_FINGER ({position('L_FINGER')}, {position('R_FINGER')})")
+    client.send_goal(goal([(-10, 0.5)], joints=("R_FINGER",)))
+    client.wait_for_result(rospy.Duration(10))
+    r = client.get_result()
+    check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.INVALID_JOINTS and "follows L_FINGER" in r.error_string,
+          f"a goal for the mimic joint: INVALID_JOINTS, saying what it follows ({r.error_string!r})")
+    check(not rospy.has_param("/robot_description"), "no kinematics: no robot_description (said in the log)")
+finally:
+    out = stop(node)
+    srv.terminate()
+    srv.wait(timeout=10)
+check("no robot_description" in out, "the log says why there is no robot_description")
 master.terminate()
 finish()

@@ -73,7 +73,9 @@ TEST_CASE("robot: a model refuses duplicates, ICS 35, reversed or unreachable li
   CHECK(why(model::make("r", {bad_dir})) == "right_knee: direction is 1 or -1");
   auto caps = other;
   caps.name = "Right Knee";
-  CHECK(why(model::make("r", {caps})).find("a-z, 0-9 and _") != std::string::npos);
+  CHECK(why(model::make("r", {caps})).find("A-Z, a-z, 0-9 and _") != std::string::npos);
+  caps.name = "RLEG_JOINT3";  // URDF's names (KXR's): upper case is a name too
+  CHECK(ok(model::make("r", {caps})));
   CHECK(why(model::make("r", {knee()}, {{"legs", {"left_knee", "right_knee"}}})) ==
         "group 'legs': no joint is called 'right_knee'");
   CHECK(why(model::make("r", {knee()}, {}, {{121, "dance"}})).find("outside 1..120") != std::string::npos);

@@ -56,7 +56,7 @@ bool ok(const outcome<T>& o) noexcept {
 
 /** One joint: a name, its servo slot, how the servo's angle maps to the joint's, its limits. */
 struct joint {
-  std::string name;                  ///< lower case, [a-z0-9_]: "left_knee"
+  std::string name;                  ///< [A-Za-z0-9_], as URDF names them: "left_knee", "LARM_JOINT0"
   ics_number ics{};                  ///< the slot: 2 × servo ID + bus (0: SIO1-4, 1: SIO5-8)
   int direction = 1;                 ///< +1 or -1: which way the servo turns for + joint degrees
   double offset = 0;                 ///< servo degrees at joint 0
@@ -108,6 +108,27 @@ inline std::optional<double> to_degrees(const joint& j, std::uint16_t p) {
   return (servo_deg - j.offset) / j.direction;
 }
 
+/**
+ * A joint with no servo of its own that follows another (URDF's mimic: two joints on one servo,
+ * such as a gripper's fingers): its angle is multiplier × the joint's + offset (degrees).
+ */
+struct mimic_joint {
+  std::string name;       ///< its own name, as a joint's
+  std::string joint;      ///< the profile joint it follows
+  double multiplier = 1;  ///< non-zero
+  double offset = 0;      ///< degrees
+  /** Its angle when the joint it follows is at @p degrees. */
+  double angle(double degrees) const noexcept { return multiplier * degrees + offset; }
+};
+
+/** True when @p name is a joint's name as profiles and URDF take it: A-Z, a-z, 0-9 and _. */
+inline bool valid_joint_name(std::string_view name) noexcept {
+  if (name.empty()) return false;
+  for (char c : name)
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  return true;
+}
+
 /** A named set of joints ("left_arm", "legs"). */
 struct group {
   std::string name;                 ///< the group's name
@@ -150,12 +171,43 @@ class model {
   std::string_view motion(unsigned slot) const noexcept;
   /** Every joint's slot. */
   servo_mask mask() const noexcept;
+  /** The joints that follow another (mimic), in the order given. */
+  const std::vector<mimic_joint>& mimics() const noexcept { return mimics_; }
+  /** The mimic joint called @p name, or nullptr. */
+  const mimic_joint* find_mimic(std::string_view name) const noexcept {
+    for (const auto& m : mimics_)
+      if (m.name == name) return &m;
+    return nullptr;
+  }
+  /**
+   * Adds @p m as a joint that follows another; a problem (and nothing added) for a name that is
+   * not valid or already a joint's, group's or mimic's, a joint that is not the profile's (a
+   * mimic does not follow a mimic), or a multiplier that is 0 or not finite.
+   */
+  std::optional<problem> add_mimic(mimic_joint m) {
+    if (!valid_joint_name(m.name)) return problem{"mimic '" + m.name + "': names use A-Z, a-z, 0-9 and _"};
+    if (m.name == "all" || find(m.name) || find_mimic(m.name))
+      return problem{"mimic '" + m.name + "': the name is already a joint's"};
+    for (const auto& g : groups_)
+      if (g.name == m.name) return problem{"mimic '" + m.name + "': the name is already a group's"};
+    if (!find(m.joint))
+      return problem{m.name + ": it follows '" + m.joint + "', which is no joint of the profile (a mimic follows a " +
+                     "joint with a servo)"};
+    if (!std::isfinite(m.multiplier) || m.multiplier == 0 || !std::isfinite(m.offset))
+      return problem{m.name + ": multiplier is a number other than 0, offset a number"};
+    mimics_.push_back(std::move(m));
+    return std::nullopt;
+  }
   /** The robot's body (links, where each joint sits), when the profile describes it; else nullptr. */
   const kinematics* body() const noexcept { return body_ ? &*body_ : nullptr; }
-  /** Gives the robot the body @p k, checked against its joints (check_body); its problem, and no body, if unsound. */
+  /**
+   * Gives the robot the body @p k, checked against its joints and mimic joints (check_body); its
+   * problem, and no body, if unsound.
+   */
   std::optional<body_problem> attach_body(kinematics k) {
     std::vector<std::string> names;
     for (const auto& j : joints_) names.push_back(j.name);
+    for (const auto& m : mimics_) names.push_back(m.name);
     if (auto p = check_body(k, names)) return p;
     body_ = std::move(k);
     return std::nullopt;
@@ -166,6 +218,7 @@ class model {
   std::vector<joint> joints_;
   std::vector<group> groups_;
   std::vector<motion_name> motions_;
+  std::vector<mimic_joint> mimics_;
   std::optional<kinematics> body_;
 };
 
@@ -178,9 +231,7 @@ inline outcome<model> model::make(std::string name, std::vector<joint> joints, s
   for (std::size_t i = 0; i < joints.size(); ++i) {
     const auto& j = joints[i];
     if (j.name.empty()) return problem{"joint " + std::to_string(i + 1) + ": no name"};
-    for (char c : j.name)
-      if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_'))
-        return problem{"joint '" + j.name + "': names use a-z, 0-9 and _"};
+    if (!valid_joint_name(j.name)) return problem{"joint '" + j.name + "': names use A-Z, a-z, 0-9 and _"};
     if (j.name == "all") return problem{"joint 'all': the name is reserved for every joint"};
     for (std::size_t k = 0; k < i; ++k)
       if (joints[k].name == j.name) return problem{"joint '" + j.name + "' is given twice"};

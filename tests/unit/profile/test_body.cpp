@@ -97,3 +97,46 @@ TEST_CASE("body: URDF in metres and radians, every joint with its limits", "[pro
   const auto bare = parse_profile("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\n", "t.yaml");
   CHECK_THROWS_WITH(to_urdf(bare), Catch::Contains("has no kinematics"));
 }
+
+TEST_CASE("body: URDF's joint names and a joint that mimics another (a gripper on one servo)", "[profile][body]") {
+  const std::string gripper =
+      "robot: g\n"
+      "joints:\n"
+      "  LARM_JOINT0: {ics: 1, lower: -90, upper: 90}\n"
+      "  L_FINGER: {ics: 2, lower: 0, upper: 60}\n"
+      "mimic:\n"
+      "  R_FINGER: {joint: L_FINGER, multiplier: -1, offset: 5}\n"
+      "kinematics:\n"
+      "  links:\n"
+      "    body: {box: [50, 80, 100]}\n"
+      "    arm: {box: [20, 20, 80]}\n"
+      "    left: {box: [5, 5, 20]}\n"
+      "    right: {box: [5, 5, 20]}\n"
+      "  joints:\n"
+      "    LARM_JOINT0: {parent: body, child: arm, axis: [0, 1, 0]}\n"
+      "    L_FINGER: {parent: arm, child: left, xyz: [0, 10, -80]}\n"
+      "    R_FINGER: {parent: arm, child: right, xyz: [0, -10, -80]}\n";
+  const auto m = parse_profile(gripper, "g.yaml");
+  REQUIRE(m.mimics().size() == 1);
+  CHECK(m.find_mimic("R_FINGER")->angle(30) == -25);
+  CHECK(m.find("LARM_JOINT0"));
+  const auto u = to_urdf(m);
+  // Its limits are the followed joint's, carried over: -1 × 0..60 + 5 = -55..5 degrees.
+  CHECK(u.find("<mimic joint=\"L_FINGER\" multiplier=\"-1\" offset=\"0.0872665\"/>") != std::string::npos);
+  CHECK(u.find("<limit lower=\"-0.959931\" upper=\"0.0872665\"") != std::string::npos);
+  // Mistakes: a mimic of an unknown joint, of a mimic, a name taken, a zero multiplier, a bad name.
+  const auto with = [&](const std::string& line) {
+    auto t = gripper;
+    t.replace(t.find("  R_FINGER: {joint"), t.find("kinematics:") - t.find("  R_FINGER: {joint"), line);
+    return error_of(t);
+  };
+  CHECK(with("  R_FINGER: {joint: NO_SUCH}\n") ==
+        "bad.yaml:6:3: R_FINGER: it follows 'NO_SUCH', which is no joint of the profile (a mimic follows a joint with "
+        "a servo)");
+  CHECK(with("  LARM_JOINT0: {joint: L_FINGER}\n") ==
+        "bad.yaml:6:3: mimic 'LARM_JOINT0': the name is already a joint's");
+  CHECK(with("  R_FINGER: {joint: L_FINGER, multiplier: 0}\n") ==
+        "bad.yaml:6:3: R_FINGER: multiplier is a number other than 0, offset a number");
+  CHECK(with("  R-FINGER: {joint: L_FINGER}\n") == "bad.yaml:6:3: mimic 'R-FINGER': names use A-Z, a-z, 0-9 and _");
+  CHECK(with("  R_FINGER: {joint: L_FINGER, gain: 2}\n").find("gain") != std::string::npos);
+}

@@ -32,6 +32,7 @@ class Actions:
 
     def __init__(self, node, ns):
         self.node = node
+        self.ns = ns
         self.control, self.kxr = messages.load()
         R = self.control.FollowJointTrajectoryResult
         self.R = R
@@ -62,8 +63,12 @@ class Actions:
         idx = []
         for name in traj.joint_names:
             if name not in node.index:
-                raise Refused(R.INVALID_JOINTS, f"no joint is called '{name}' (the joints: ~joints or "
-                                                f"{rospy.resolve_name('fullbody_controller/joints')})")
+                follows = next((node.prefix + node.names[j] for m, j, _, _ in node.mimics if m == name), None)
+                if follows:
+                    raise Refused(R.INVALID_JOINTS, f"{name} follows {follows} (mimic: no servo of its own): "
+                                                    f"command {follows}")
+                raise Refused(R.INVALID_JOINTS, f"no joint is called '{name}' (the joints: "
+                                                f"{rospy.resolve_name(self.ns + '/joints')})")
             if node.index[name] in idx:
                 raise Refused(R.INVALID_JOINTS, f"{name} is named twice")
             idx.append(node.index[name])

@@ -55,6 +55,9 @@ class Rcb4Node:
         self.names = self.board.joint_names
         self.limits = self.board.joint_limits
         self.index = {self.prefix + n: i for i, n in enumerate(self.names)}
+        # Joints on another's servo (the profile's mimic:), in joint_states as URDF's mimic says.
+        self.mimics = [(self.prefix + n, self.names.index(j), k, off)
+                       for n, (j, k, off) in self.board.mimic_joints.items()]
         self.loop = self.board.control_loop()
         self.angles = numpy.full(len(self.names), numpy.nan)
         self.requests = queue.Queue()  # (what, argument, reply) for the loop thread
@@ -113,6 +116,9 @@ class Rcb4Node:
         for name, rad in zip(names, positions):
             i = self.index.get(name)
             if i is None:
+                follows = next((self.prefix + self.names[j] for m, j, _, _ in self.mimics if m == name), None)
+                if follows:
+                    raise ValueError(f"{what}: {name} follows {follows} (mimic: no servo of its own): command {follows}")
                 raise ValueError(f"{what}: no joint is called '{name}'")
             if not math.isnan(targets[i]):
                 raise ValueError(f"{what}: {name} is given twice")
@@ -413,6 +419,10 @@ class Rcb4Node:
             if not math.isnan(deg):  # a servo that does not answer is left out, never made up
                 msg.name.append(self.prefix + name)
                 msg.position.append(math.radians(deg))
+        for name, j, k, off in self.mimics:
+            if not math.isnan(self.angles[j]):
+                msg.name.append(name)
+                msg.position.append(math.radians(k * self.angles[j] + off))
         self.states.publish(msg)
         self.cycles += 1
 
