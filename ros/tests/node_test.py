@@ -249,12 +249,18 @@ try:
           "a silent board: diagnostics ERROR")
     time.sleep(0.5)
     quiet = time.monotonic()
+    silent_cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2)
+    wait_for(lambda: silent_cmd.get_num_connections() > 0)
+    silent_cmd.publish(JointTrajectory(joint_names=["head_yaw"], points=[
+        JointTrajectoryPoint(positions=[0.3], time_from_start=rospy.Duration(0.2))]))
     time.sleep(1.0)
     check(not [t for t, _ in states if t > quiet], "and no joint_states while it is silent")
     board.silent = False
     back = time.monotonic()
     check(wait_for(lambda: [t for t, _ in states if t > back], timeout=5), "joint_states again once it answers")
-    stop(node)
+    out = stop(node) and node.stdout.read()
+    check("a command was dropped: the board does not answer" in out,
+          f"a command sent while the board is silent is dropped, and logged ({out[-300:]!r})")
 
     # A device that goes away (unplugged) and comes back under the same path (a udev link): the
     # node opens it again by itself.

@@ -517,6 +517,16 @@ class Rcb4Node:
                         rospy.logerr("rcb4: %s", e)
                     self.link_ok, self.link_reason = False, str(e)
                     self.angles[:] = numpy.nan
+                    # What is under way (or comes in) while the board is silent is dropped, and
+                    # said: it must not run late, all at once, when the board answers again.
+                    with self.lock:
+                        pending = bool(self.trajectory) or self.stream is not None
+                        self.trajectory, self.stream = [], None
+                        if pending:
+                            self.generation += 1
+                            self.replaced_by = f"dropped: the board does not answer ({e})"
+                    if pending:
+                        self.refuse(f"a command was dropped: the board does not answer ({e})")
                 if self.reopen_at is not None and time.monotonic() >= self.reopen_at:
                     self.reopen()
                 if time.monotonic() - last_diag >= 1.0:
