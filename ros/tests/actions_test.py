@@ -240,7 +240,9 @@ try:
 finally:
     out = stop(node)
 j = tool_joints(dev)
-check(j.get("left_knee", {}).get("state") == "free", f"rcb4 joint list after the node: left_knee free ({j.get('left_knee')})")
+check(j.get("left_knee", {}).get("state") == "free" and abs(j.get("head_yaw", {}).get("degrees", 99) - math.degrees(0.1)) < 1
+      and abs(j["left_knee"]["degrees"] - math.degrees(0.1)) < 1,
+      f"rcb4 joint list after the node: the joints where the goal put them (0.1 rad), left_knee free ({j.get('left_knee')})")
 check("follow_joint_trajectory: refused, nothing moves: no joint is called 'no_such_joint'" in out,
       "a refused goal is logged with its reason")
 srv.terminate()
