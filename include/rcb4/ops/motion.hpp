@@ -124,7 +124,8 @@ struct motion_state {
   std::optional<unsigned> motion;     ///< its number under the layout, when the PC is in a motion slot
   std::uint32_t program_counter = 0;  ///< where the ROM program is
   unsigned depth = 0;                 ///< the call stack's depth (RAM 0x0005): CALLs pending, the play's own included
-  bool program_on = true;  ///< the ROM program runs (config bit 1): off after motion stop or a ROM restore, buttons play nothing
+  bool program_on =
+      true;  ///< the ROM program runs (config bit 1): off after motion stop or a ROM restore, buttons play nothing
   friend bool operator==(const motion_state&, const motion_state&) = default;
 };
 

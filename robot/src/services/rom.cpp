@@ -83,19 +83,17 @@ std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check)
   std::string word;
   if (!(sum >> word)) {
     if (no_check) return image;
-    throw refused(refusal_kind::usage,
-                  fmt::format("{}.crc32 is missing or empty: the image cannot be checked", path),
+    throw refused(refusal_kind::usage, fmt::format("{}.crc32 is missing or empty: the image cannot be checked", path),
                   "rcb4 rom backup writes it beside the image; --no-check restores one without it (its plausibility "
                   "is still checked)");
   }
   const auto want = fmt::format("{:08x}", crc32(image));
   if (word != want)
-    throw refused(
-        refusal_kind::usage,
-        fmt::format("{} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
-        fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
-                    "delete {}.crc32 and restore with --no-check",
-                    path, path));
+    throw refused(refusal_kind::usage,
+                  fmt::format("{} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
+                  fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
+                              "delete {}.crc32 and restore with --no-check",
+                              path, path));
   return image;
 }
 
