@@ -39,7 +39,7 @@ from kxr_controller.msg import AdjustAngleVectorAction, AdjustAngleVectorGoal  #
 from kxr_controller.msg import ServoOnOffAction, ServoOnOffGoal, Stretch, StretchAction, StretchGoal  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import UInt8  # noqa: E402
-from trajectory_msgs.msg import JointTrajectoryPoint  # noqa: E402
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E402
 
 rospy.init_node("rcb4_actions_test", anonymous=True, disable_signals=True)
 states = []
@@ -235,15 +235,43 @@ try:
     check(r.returncode == 0 and "result 3 0" in r.stdout and abs(position("left_knee") - math.degrees(0.1)) < 1,
           f"a kxr_controller user's script runs unchanged: every servo on, all joints to 0.1 rad ({r.stdout.strip()!r} "
           f"{r.stderr.strip()[-300:]!r})")
+    # A ~command for another joint takes over: the goal is preempted, its joints hold (they do not
+    # run on to the end of a goal nobody watches any more).
+    cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2)
+    wait_for(lambda: cmd.get_num_connections() > 0)
+    client.send_goal(goal([(60, 2.0)], joints=("right_knee",)))
+    time.sleep(0.5)
+    cmd.publish(JointTrajectory(joint_names=["head_yaw"], points=[
+        JointTrajectoryPoint(positions=[0.0], time_from_start=rospy.Duration(0.3))]))
+    client.wait_for_result(rospy.Duration(5))
+    time.sleep(0.2)
+    at = position("right_knee")
+    time.sleep(1.0)
+    check(client.get_state() == GoalStatus.PREEMPTED and at < 40 and abs(position("right_knee") - at) < 1,
+          f"a ~command takes over: the goal PREEMPTED, right_knee holds at {at:.1f} (now {position('right_knee'):.1f})")
+    # The node stopped (SIGINT) during a goal: the client is told, the joints hold.
+    client.send_goal(goal([(-60, 3.0)], joints=("right_knee",)))
+    time.sleep(0.6)
+    first_out = out = stop(node)
+    ended = client.wait_for_result(rospy.Duration(3))
+    last = position("right_knee")
+    check(ended and client.get_state() == GoalStatus.ABORTED and "node stopped" in client.get_goal_status_text()
+          and "publish() to a closed topic" not in out,
+          f"SIGINT during a goal: ABORTED, said ({client.get_state()}, {client.get_goal_status_text()!r})")
+    knee = tool_joints(dev).get("right_knee", {}).get("degrees")
+    check(knee is not None and abs(knee - last) < 3 and knee > -50,
+          f"and right_knee holds where it was (the tool reads {knee}, the last joint_states {last:.1f}), not -60")
+    node = start_node(f"_device:={dev}", "_rate:=50")
+    on_off = actionlib.SimpleActionClient("/fullbody_controller/servo_on_off_real_interface", ServoOnOffAction)
+    on_off.wait_for_server(rospy.Duration(20))
     on_off.send_goal(ServoOnOffGoal(joint_names=["left_knee"], servo_on_states=[False]))
     on_off.wait_for_result(rospy.Duration(5))
 finally:
     out = stop(node)
 j = tool_joints(dev)
-check(j.get("left_knee", {}).get("state") == "free" and abs(j.get("head_yaw", {}).get("degrees", 99) - math.degrees(0.1)) < 1
-      and abs(j["left_knee"]["degrees"] - math.degrees(0.1)) < 1,
+check(j.get("left_knee", {}).get("state") == "free" and abs(j["left_knee"]["degrees"] - math.degrees(0.1)) < 1,
       f"rcb4 joint list after the node: the joints where the goal put them (0.1 rad), left_knee free ({j.get('left_knee')})")
-check("follow_joint_trajectory: refused, nothing moves: no joint is called 'no_such_joint'" in out,
+check("follow_joint_trajectory: refused, nothing moves: no joint is called 'no_such_joint'" in first_out,
       "a refused goal is logged with its reason")
 srv.terminate()
 srv.wait(timeout=10)
@@ -278,6 +306,24 @@ try:
           f"{client.get_state()})")
 finally:
     stop(node)
+# A servo that never answers (serve --silent 16: left_knee) is not within any tolerance.
+srv = subprocess.Popen([RCB4, "serve", "--pty", "--silent", "16"], stdout=subprocess.PIPE, text=True)
+dev = srv.stdout.readline().strip()
+node = start_node(f"_device:={dev}", "_rate:=50")
+try:
+    client = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
+    client.wait_for_server(rospy.Duration(20))
+    client.send_goal(goal([([20, -20], 0.3)], joints=("left_knee", "right_knee"), goal_time=0.3))
+    client.wait_for_result(rospy.Duration(10))
+    r = client.get_result()
+    check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.GOAL_TOLERANCE_VIOLATED
+          and "left_knee has no measured position" in r.error_string,
+          f"a joint that never answers: GOAL_TOLERANCE_VIOLATED ({r.error_string!r})")
+finally:
+    stop(node)
+    srv.terminate()
+    srv.wait(timeout=10)
+
 # A robot whose URDF names its joints in upper case and has two joints on one servo (a gripper):
 # joint_states carries both, the follower as URDF's mimic says; it cannot be commanded itself.
 profile = os.path.join(tempfile.mkdtemp(), "gripper.yaml")

@@ -79,9 +79,15 @@ class Actions:
             t = p.time_from_start.to_sec()
             if len(p.positions) != len(idx):
                 raise Refused(R.INVALID_GOAL, f"point {k}: {len(p.positions)} positions for {len(idx)} joints")
-            if not math.isfinite(t) or t < 0 or (k > 0 and t <= last):
+            if not math.isfinite(t) or t < 0:
+                raise Refused(R.INVALID_GOAL, f"point {k}: time_from_start {t:.3f} s is not a time from the start")
+            if k > 0 and t <= last:
                 raise Refused(R.INVALID_GOAL, f"point {k}: time_from_start {t:.3f} s does not come after "
                                               f"{last:.3f} s")
+            for field in ("velocities", "accelerations", "effort"):
+                given = len(getattr(p, field))
+                if given and given != len(idx):
+                    raise Refused(R.INVALID_GOAL, f"point {k}: {given} {field} for {len(idx)} joints")
             try:
                 node.degrees_of(traj.joint_names, p.positions, f"point {k}")  # NaN, limits
             except ValueError as e:
@@ -144,8 +150,16 @@ class Actions:
                 return self.end(self.trajectory.set_preempted, R.SUCCESSFUL,
                                 "cancelled: the joints hold where they are")
             if node.generation != generation:
-                return self.end(self.trajectory.set_aborted, R.INVALID_GOAL, node.replaced_by or "replaced",
-                                hold=False)
+                # Another command took over: the goal's joints it does not name hold where they
+                # are (the rest of this goal does not run on unwatched); the client is told.
+                keep = [i for i in idx if i not in node.replacing] if node.replaced_by.startswith("replaced") else []
+                if keep:
+                    node.drop(keep)
+                    node.queue("hold_some", keep)
+                why = node.replaced_by or "replaced"
+                if why.startswith(("the node stopped", "dropped")):
+                    return self.end(self.trajectory.set_aborted, R.INVALID_GOAL, why, hold=False)
+                return self.end(self.trajectory.set_preempted, R.SUCCESSFUL, why, hold=False)
             if not node.link_ok:
                 return self.end(self.trajectory.set_aborted, R.INVALID_GOAL,
                                 f"the board does not answer: {node.link_reason}")
@@ -177,16 +191,24 @@ class Actions:
                                     f"{t:.2f} s (tolerance {math.degrees(path[j]):.2f}): the joints hold where they are")
             elif t >= times[-1]:
                 final_error = rows[-1] - actual
-                bad = checked & (numpy.abs(final_error) > tol)
+                # A joint whose position is not measured is not within any tolerance.
+                bad = ~free & (numpy.isnan(final_error) | (numpy.abs(final_error) > tol))
                 if not bad.any():
                     return self.trajectory.set_succeeded(R(error_code=R.SUCCESSFUL, error_string=""), "")
                 if t > times[-1] + goal_time:
                     j = int(numpy.flatnonzero(bad)[0])
+                    far = ("has no measured position (its servo does not answer)" if math.isnan(final_error[j])
+                           else f"is {math.degrees(abs(final_error[j])):.2f} deg from its goal")
                     return self.end(self.trajectory.set_aborted, R.GOAL_TOLERANCE_VIOLATED,
-                                    f"{names[j]} is {math.degrees(abs(final_error[j])):.2f} deg from its goal "
-                                    f"{goal_time:.2f} s after the last point (tolerance {math.degrees(tol[j]):.2f}): "
-                                    "the joints hold where they are")
+                                    f"{names[j]} {far} {goal_time:.2f} s after the last point (tolerance "
+                                    f"{math.degrees(tol[j]):.2f}): the joints hold where they are")
             time.sleep(period)
+
+    def wait_idle(self, timeout):
+        """Waits (at most @p timeout s) for the trajectory goal under way to end."""
+        end = time.monotonic() + timeout
+        while self.trajectory.is_active() and time.monotonic() < end:
+            time.sleep(0.02)
 
     def cancel_goal(self, why):
         """Ends the trajectory goal under way (kxr_controller cancels it before servo changes)."""

@@ -68,6 +68,7 @@ class Rcb4Node:
         self.halt = False              # stop: every joint under way holds where it is, at the next cycle
         self.generation = 0            # counts what replaced the trajectory (a new one, a stop): actions watch it
         self.replaced_by = ""          # why the last trajectory ended early
+        self.replacing = set()         # the joints (indices) the command that replaced it names
         self.moves = {}                # joint index -> (t0, from, to, t1) degrees: the move the board makes now
         self.refused_at = {}           # refusal text -> when it was last logged (repeats once a second)
         self.link_ok, self.link_reason = True, ""
@@ -172,6 +173,7 @@ class Rcb4Node:
             self.stream = None
             self.generation += 1
             self.replaced_by = "replaced by a newer trajectory or command"
+            self.replacing = {i for _, t, _ in self.trajectory for i in numpy.flatnonzero(~numpy.isnan(t))}
             return self.generation
 
     def on_trajectory(self, msg):
@@ -210,6 +212,7 @@ class Rcb4Node:
             self.stream = targets
             self.generation += 1
             self.replaced_by = "replaced by a joint_command"
+            self.replacing = set(int(i) for i in numpy.flatnonzero(~numpy.isnan(targets)))
             # The joints it names leave the trajectory under way; the others go on with it.
             named = ~numpy.isnan(targets)
             rest = []
@@ -236,7 +239,8 @@ class Rcb4Node:
         result = {}
         self.queue(what, argument, (done, result))
         if not done.wait(timeout):
-            return False, f"the board did not answer in {timeout:g} s"
+            result["abandoned"] = True  # not carried out later, when nobody waits for it any more
+            return False, f"the board did not answer in {timeout:g} s: nothing was done"
         return result.get("ok", False), result.get("message", "")
 
     def trigger(self, what, argument):
@@ -250,8 +254,18 @@ class Rcb4Node:
             except queue.Empty:
                 return
             ok, message = True, ""
+            if reply and reply[1].get("abandoned"):
+                rospy.logwarn("rcb4: %s: dropped, its caller gave up waiting (the board did not answer)", what)
+                continue
             try:
-                if what in ("free", "hold"):
+                if what == "hold_some":
+                    names = [self.names[i] for i in argument if not self.freed[i]]
+                    if names:
+                        self.board.hold(*names)
+                    for i in argument:
+                        self.moves.pop(i, None)
+                    message = f"held {len(names)} joints"
+                elif what in ("free", "hold"):
                     names = [n[len(self.prefix):] if n.startswith(self.prefix) else n
                              for n in (argument or "").replace(",", " ").split()]
                     done = (self.board.free if what == "free" else self.board.hold)(*names)
@@ -392,12 +406,23 @@ class Rcb4Node:
             at, targets, frames = due
             if frames > 0:
                 frames = max(1, round((at + frames * self.period - now) / self.period))
-            self.loop.write(targets, frames=frames)
-            self.moved(targets, frames, now)
+            self.write(targets, frames, now)
         elif stream is not None:
-            frames = max(1, round(1.0 / self.rate / self.period))
-            self.loop.write(stream, frames=frames)
-            self.moved(stream, frames, now)
+            self.write(stream, max(1, round(1.0 / self.rate / self.period)), now)
+
+    def write(self, targets, frames, now):
+        """Sends a move; one the board refuses (a joint with no servo on it) is dropped and said, with
+        what was under way: it is not the link failing."""
+        try:
+            self.loop.write(targets, frames=frames)
+        except pyrcb4.BoardRefused as e:
+            with self.lock:
+                self.trajectory, self.stream = [], None
+                self.generation += 1
+                self.replaced_by = f"dropped: {e}"
+            self.refuse(f"a command was dropped: {e}")
+            return
+        self.moved(targets, frames, now)
 
     def moved(self, targets, frames, now):
         """Keeps the moves just sent (for AdjustAngleVector's reference)."""
@@ -527,6 +552,9 @@ class Rcb4Node:
                             self.replaced_by = f"dropped: the board does not answer ({e})"
                     if pending:
                         self.refuse(f"a command was dropped: the board does not answer ({e})")
+                    self.drop_requests(str(e))
+                if self.released:
+                    self.drop_requests(self.link_reason)
                 if self.reopen_at is not None and time.monotonic() >= self.reopen_at:
                     self.reopen()
                 if time.monotonic() - last_diag >= 1.0:
@@ -538,8 +566,31 @@ class Rcb4Node:
                     time.sleep(min(delay, 0.05))  # wakes for shutdown within 50 ms
                     delay = next_cycle - time.monotonic()
         finally:
+            # An action goal under way ends (aborted, said to its client) and every joint holds
+            # where it is before the board is let go: nothing runs on after the node.
+            self.stop_now("the node stopped (SIGINT/SIGTERM): the joints hold where they are")
+            if not self.released:
+                try:
+                    self.halt_now()
+                except pyrcb4.Error:
+                    pass
+            if self.actions:
+                self.actions.wait_idle(1.0)
             if not self.released:
                 self.board.close()
+
+    def drop_requests(self, why):
+        """What was asked while the board does not answer is dropped, answered and logged: it must not
+        run later, when a board answers again."""
+        while True:
+            try:
+                what, _, reply = self.requests.get_nowait()
+            except queue.Empty:
+                return
+            rospy.logwarn("rcb4: %s: dropped, the board does not answer (%s)", what, why)
+            if reply:
+                reply[1].update(ok=False, message=f"{what}: the board does not answer ({why}): nothing was done")
+                reply[0].set()
 
 
 def main():
