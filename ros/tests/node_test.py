@@ -281,12 +281,26 @@ try:
     fds = f"/proc/{node.pid}/fd"
     check(wait_for(lambda: not any("(deleted)" in os.readlink(os.path.join(fds, f)) for f in os.listdir(fds)),
                    timeout=3), "the device gone: the node holds no descriptor of it")
+    # Asked while it is gone: answered as failed, and never carried out when a board comes back.
+    r = rospy.ServiceProxy("/rcb4/free", Trigger)()
+    gone_play = rospy.Publisher("/rcb4/play_motion", UInt8, queue_size=2)
+    wait_for(lambda: gone_play.get_num_connections() > 0)
+    gone_play.publish(UInt8(2))
+    time.sleep(0.5)
+    check(not r.success, f"~free while the board is gone: failed, said ({r.message!r})")
     serve_b = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
     os.remove(link)
-    os.symlink(serve_b.stdout.readline().strip(), link)
+    dev_b = serve_b.stdout.readline().strip()
+    os.symlink(dev_b, link)
     back = time.monotonic()
     check(wait_for(lambda: [t for t, _ in states if t > back], timeout=6), "back under the same path: joint_states again")
+    time.sleep(1.0)
     stop(node)
+    st = subprocess.run([RCB4, "--json", "--device", dev_b, "motion", "status"], capture_output=True, text=True, timeout=30)
+    j = tool_joints(dev_b)
+    check(st.returncode == 0 and json.loads(st.stdout).get("motion") is None and j
+          and not any(v["state"] == "free" for v in j.values()),
+          f"back: nothing asked while it was gone was done (no motion played, no joint freed) ({st.stdout.strip()!r})")
     serve_b.terminate()
     serve_b.wait(timeout=10)
     # No ~device: the in-process virtual board, with a warning that it is no robot; a bad ~timeout
