@@ -291,15 +291,25 @@ try:
     serve_b = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
     os.remove(link)
     dev_b = serve_b.stdout.readline().strip()
+    subprocess.run([RCB4, "--device", dev_b, "joint", "free", "head_yaw"], capture_output=True, timeout=30)
     os.symlink(dev_b, link)
     back = time.monotonic()
     check(wait_for(lambda: [t for t, _ in states if t > back], timeout=6), "back under the same path: joint_states again")
     time.sleep(1.0)
+    # The board now answering has head_yaw free: the node reads it, and a command leaves it out.
+    back_cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2)
+    wait_for(lambda: back_cmd.get_num_connections() > 0)
+    back_cmd.publish(JointTrajectory(joint_names=["head_yaw"], points=[
+        JointTrajectoryPoint(positions=[0.5], time_from_start=rospy.Duration(0.3))]))
+    time.sleep(0.8)
     stop(node)
+    out = node.stdout.read()
+    check("free on the board: head_yaw" in out and "head_yaw is free: left out" in out,
+          f"after a reconnect, the joints free on the new board are read as free ({out[-300:]!r})")
     st = subprocess.run([RCB4, "--json", "--device", dev_b, "motion", "status"], capture_output=True, text=True, timeout=30)
     j = tool_joints(dev_b)
     check(st.returncode == 0 and json.loads(st.stdout).get("motion") is None and j
-          and not any(v["state"] == "free" for v in j.values()),
+          and not any(v["state"] == "free" for n, v in j.items() if n != "head_yaw") and j["head_yaw"]["state"] == "free",
           f"back: nothing asked while it was gone was done (no motion played, no joint freed) ({st.stdout.strip()!r})")
     serve_b.terminate()
     serve_b.wait(timeout=10)

@@ -65,6 +65,7 @@ class Rcb4Node:
         self.trajectory = []           # [(due monotonic time, targets in degrees, frames)], next first
         self.stream = None             # (targets in degrees, received) from ~joint_command
         self.freed = numpy.zeros(len(self.names), dtype=bool)  # freed joints: no command powers them again
+        self.read_freed()
         self.halt = False              # stop: every joint under way holds where it is, at the next cycle
         self.generation = 0            # counts what replaced the trajectory (a new one, a stop): actions watch it
         self.replaced_by = ""          # why the last trajectory ended early
@@ -304,6 +305,21 @@ class Rcb4Node:
                 reply[1].update(ok=ok, message=message)
                 reply[0].set()
 
+    def read_freed(self):
+        """Which joints are free on the board now (target FREE): at start and after a reconnect the
+        node knows nothing else of them."""
+        try:
+            servos = self.board.servos()
+        except pyrcb4.Error as e:
+            rospy.logwarn("rcb4: the servos' states could not be read (%s): joints taken as held", e)
+            self.freed[:] = False
+            return
+        targets = {v["joint"]: v["target"] for v in servos.values()}
+        for i, n in enumerate(self.names):
+            self.freed[i] = targets.get(n) == 0x8000
+        if self.freed.any():
+            rospy.loginfo("rcb4: free on the board: %s", ", ".join(self.prefix + n for n, f in zip(self.names, self.freed) if f))
+
     def unprefixed(self, name):
         return name[len(self.prefix):] if self.prefix and name.startswith(self.prefix) else name
 
@@ -487,6 +503,7 @@ class Rcb4Node:
             return
         self.board, self.released, self.where = board, False, board.where
         self.loop = self.board.control_loop()
+        self.read_freed()  # the board that answers now may not be the one whose joints were freed
         self.reopen_at = None
         rospy.loginfo("rcb4: %s opened again", self.device)
 
