@@ -22,6 +22,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "tests", "integration")]
 from checks import check, finish  # noqa: E402
 import master as rosmaster  # noqa: E402
+from master import wait_for  # noqa: E402
 from standin import StandIn  # noqa: E402
 
 RCB4, PYRCB4, NODE_SRC, MESSAGES = sys.argv[1:5]
@@ -44,16 +45,6 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E
 rospy.init_node("rcb4_actions_test", anonymous=True, disable_signals=True)
 states = []
 rospy.Subscriber("/joint_states", JointState, lambda m: states.append(m), queue_size=100)
-
-
-def wait_for(pred, timeout=10):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.05)
-    return None
 
 
 def position(name):

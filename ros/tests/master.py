@@ -28,3 +28,14 @@ def start(pyrcb4_dir, node_src, name="/rcb4_test"):
             time.sleep(0.1)
     master.kill()
     raise RuntimeError(f"rosmaster on port {port} did not answer in 10 s")
+
+
+def wait_for(pred, timeout=10):
+    """@p pred's first true value within @p timeout seconds (polled every 50 ms), or None."""
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        v = pred()
+        if v:
+            return v
+        time.sleep(0.05)
+    return None

@@ -18,6 +18,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.path.join(HERE, "..", "..", "tests", "integration")]
 from checks import check, finish  # noqa: E402
 import master as rosmaster  # noqa: E402 (ros/tests/master.py)
+from master import wait_for  # noqa: E402
 from standin import StandIn  # noqa: E402
 
 RCB4, PYRCB4, NODE_SRC = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -42,16 +43,6 @@ rospy.Subscriber("/diagnostics", DiagnosticArray, lambda m: diags.append((time.m
 def start_node(*params):
     return subprocess.Popen([sys.executable, NODE, *params], env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             text=True)
-
-
-def wait_for(pred, timeout=10):
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        v = pred()
-        if v:
-            return v
-        time.sleep(0.05)
-    return None
 
 
 def stop(node):
