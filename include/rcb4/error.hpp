@@ -57,10 +57,16 @@ enum class errc : std::uint8_t {
   motion_slot_not_a_frame,  ///< the slot's first bytes fail a frame's checksum: another ROM layout?
   servo_not_allocated,      ///< a servo the operation names has no block in the ICS allocation table
   bad_allocation_table,     ///< an ICS allocation entry is no servo block: odd, overlapping, outside the user area
+  // ICS servos on their own line (ics.md; rcb4/ics/)
+  ics_id_out_of_range,     ///< ICS servo ID not in 0–31 (ics.md §2.1)
+  ics_value_out_of_range,  ///< an ICS parameter or EEPROM field outside its range (ics.md §3)
+  ics_line_echo_mismatch,  ///< the one-wire line's echo differs from what was sent: a collision (ics.md §1)
+  ics_bad_reply,           ///< an ICS reply's header, sub-command, ID or value is not the one asked (ics.md §2.3)
+  ics_bad_eeprom,          ///< an EEPROM image with a byte above 0x0F or without the 0x5A check mark (ics.md §4.1)
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::bad_allocation_table;
+inline constexpr errc errc_last = errc::ics_bad_eeprom;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -112,6 +118,12 @@ constexpr const char* message(errc e) noexcept {
     case errc::bad_allocation_table:
       return "the board's ICS allocation table (RAM 0x0044) is not a servo map: an entry points at an odd "
              "address, outside the user area 0x0090-0x048F, or into another servo's block";
+    case errc::ics_id_out_of_range: return "ICS servo ID out of range 0-31";
+    case errc::ics_value_out_of_range: return "ICS servo parameter out of its range";
+    case errc::ics_line_echo_mismatch:
+      return "the ICS line's echo differs from what was sent: another device talked at the same time (collision)";
+    case errc::ics_bad_reply: return "the ICS reply is not the one asked (header, sub-command, ID or value differs)";
+    case errc::ics_bad_eeprom: return "ICS EEPROM image invalid: a byte above 0x0F or no 0x5A check mark";
   }
   return "unknown rcb4 error";
 }

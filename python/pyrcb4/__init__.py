@@ -5,6 +5,12 @@
         print(b.joints()["left_knee"])
         b.move({"left_knee": 40}, time=0.8)
 
+One ICS servo on its own line (a KONDO adapter in ICS mode), as `rcb4 ics` sets one up:
+
+    with pyrcb4.IcsServo() as s:         # None: an in-process virtual servo; or "/dev/ttyUSB0"
+        s.set(stretch=40, speed=100)     # the old EEPROM image saved first (ics-idN-STAMP.bin)
+        s.move(degrees=30)
+
 The work is done by rcb4's C++ library (the _core extension); every failure is a pyrcb4.Error.
 """
 from ._core import (  # noqa: F401
@@ -14,10 +20,12 @@ from ._core import (  # noqa: F401
     ControlLoop,
     DeviceError,
     Error,
+    IcsServo,
     LimitError,
     Timeout,
     UsageError,
     __version__,
+    ics_scan,
     load_pose,
     move_refusal,
     save_pose,
@@ -29,8 +37,9 @@ class ArgumentError(UsageError, TypeError):
     """An argument of the wrong type (a UsageError, and a TypeError as Python raises for one)."""
 
 
-def _one_line(name, method):
-    """method, with pybind11's many-line "incompatible function arguments" TypeError as one line."""
+def _one_line(name, method, cls="Board", bound=True):
+    """method (of pyrcb4.cls; bound=False: a module function), with pybind11's many-line
+    "incompatible function arguments" TypeError as one line."""
     import functools
 
     @functools.wraps(method)
@@ -46,18 +55,21 @@ def _one_line(name, method):
             for line in text.splitlines():
                 if line.strip().startswith("1. ("):
                     takes = line.strip()[3:].split(") -> ")[0] + ")"
-                    takes = takes.replace("self: pyrcb4._core.Board, ", "").replace("self: pyrcb4._core.Board", "")
+                    takes = takes.replace(f"self: pyrcb4._core.{cls}, ", "").replace(f"self: pyrcb4._core.{cls}", "")
                     takes = takes.replace("*args", "*names")
-            given = repr(tuple(args[1:])) if not kwargs else \
-                "(" + ", ".join([repr(a) for a in args[1:]] + [f"{k}={v!r}" for k, v in kwargs.items()]) + ")"
+            passed = args[1:] if bound else args
+            given = repr(tuple(passed)) if not kwargs else \
+                "(" + ", ".join([repr(a) for a in passed] + [f"{k}={v!r}" for k, v in kwargs.items()]) + ")"
             raise ArgumentError(f"{name}{takes or '(...)'}: called with {given}") from None
     return call
 
 
-for _name, _member in list(vars(Board).items()):
-    if _name == "__init__" or (not _name.startswith("_") and callable(_member)):
-        setattr(Board, _name, _one_line("Board" if _name == "__init__" else _name, _member))
-del _name, _member
+for _cls in (Board, IcsServo):
+    for _name, _member in list(vars(_cls).items()):
+        if _name == "__init__" or (not _name.startswith("_") and callable(_member)):
+            setattr(_cls, _name, _one_line(_cls.__name__ if _name == "__init__" else _name, _member, _cls.__name__))
+ics_scan = _one_line("ics_scan", ics_scan, bound=False)
+del _cls, _name, _member
 
-__all__ = ["Board", "ArgumentError", "ControlLoop", "load_pose", "save_pose", "move_refusal", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
+__all__ = ["Board", "IcsServo", "ics_scan", "ArgumentError", "ControlLoop", "load_pose", "save_pose", "move_refusal", "Error", "BoardRefused", "Timeout", "DeviceError", "BadReply", "LimitError", "UsageError",
            "__version__"]

@@ -276,4 +276,12 @@ class control_loop {
 /** Raises the board_error that @p ec is, with @p what (the operation) in its message. */
 [[noreturn]] void raise(const std::error_code& ec, const std::string& what);
 
+/** The exception class (fault) a service's refusal is in Python (board_services.cpp): one mapping for every binding. */
+fault fault_of(rcb4::robot::services::refusal_kind k);
+/**
+ * Raises the board_error that the refusal @p e is, its message "@p what: why (hint)" in Python's
+ * words (python_words); a refusal of kind line with an error code goes through raise().
+ */
+[[noreturn]] void raise_refusal(const rcb4::robot::services::refused& e, const std::string& what);
+
 }  // namespace pyrcb4

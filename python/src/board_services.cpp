@@ -35,7 +35,8 @@ class client_link final : public sv::link {
   t::response last_;
 };
 
-/** The exception a refusal is in Python. */
+}  // namespace
+
 fault fault_of(sv::refusal_kind k) {
   switch (k) {
     case sv::refusal_kind::usage: return fault::usage;
@@ -46,10 +47,21 @@ fault fault_of(sv::refusal_kind k) {
   }
   return fault::refused;
 }
-}  // namespace
+
+void raise_refusal(const sv::refused& e, const std::string& what) {
+  const std::string text = python_words(what + ": " + e.what() + (e.hint.empty() ? "" : " (" + e.hint + ")"));
+  if (e.kind == sv::refusal_kind::line && e.code) raise(e.code, text);
+  throw board_error(fault_of(e.kind), text);
+}
 
 std::string python_words(std::string text) {
   static constexpr std::pair<std::string_view, std::string_view> words[] = {
+      // IcsServo's (rcb4/robot/services/ics.hpp words its hints for `rcb4 ics`).
+      {"rcb4 ics eeprom restore ", "restore() of "},
+      {"rcb4 ics eeprom show", "eeprom()"},
+      {"rcb4 ics id set N", "set_id(n)"},
+      {"rcb4 ics id set", "set_id()"},
+      {"rcb4 ics position free", "free()"},
       {"rcb4 motion buttons set", "set_button()"},
       {"rcb4 motion buttons clear", "clear_button()"},
       {"rcb4 motion buttons reset", "set_button() for each entry after clearing"},
@@ -97,10 +109,7 @@ auto board::service(const char* what, F&& f) {
   try {
     return f(l);
   } catch (const sv::refused& e) {
-    const std::string text =
-        python_words(std::string(what) + ": " + e.what() + (e.hint.empty() ? "" : " (" + e.hint + ")"));
-    if (e.kind == sv::refusal_kind::line && e.code) raise(e.code, text);
-    throw board_error(fault_of(e.kind), text);
+    raise_refusal(e, what);
   } catch (const std::system_error& e) {
     fail(e.code(), what);
   } catch (const rcb4::robot::profile_error& e) {

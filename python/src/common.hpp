@@ -84,5 +84,7 @@ inline std::string path_of(const py::object& path) {
 void bind_robot(py::module_& m, py::class_<board>& cls);
 /** Adds the robot services to Board: motion slots, buttons, the ROM (bind_services.cpp). */
 void bind_services(py::class_<board>& cls);
+/** Adds IcsServo (one ICS servo on its own line) and ics_scan (bind_ics.cpp). */
+void bind_ics(py::module_& m);
 
 }  // namespace pyrcb4

@@ -421,4 +421,5 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
           "supply divided by 5), pio_direction, pio_value, buttons, button_names, pa (PA1..PA4).");
   bind_robot(m, cls);
   bind_services(cls);
+  bind_ics(m);
 }

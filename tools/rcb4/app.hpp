@@ -288,6 +288,7 @@ void add_robot_commands(CLI::App& app, context& ctx);       ///< joint, pose, tr
 void add_ui_command(CLI::App& app, context& ctx);           ///< ui (cmd_ui.cpp, ui/)
 void add_rom_commands(CLI::App& app, context& ctx);         ///< rom backup|restore (cmd_rom.cpp)
 void add_urdf_command(CLI::App& app, context& ctx);         ///< urdf (cmd_urdf.cpp)
+void add_ics_commands(CLI::App& app, context& ctx);         ///< ics … (cmd_ics.cpp, cmd_ics_serve.cpp)
 void add_project_commands(CLI::App& app, context& ctx);     ///< project import|export (cmd_project.cpp)
 void add_trim_import(CLI::App* trim, context& ctx);         ///< trim import (cmd_project.cpp)
 void add_startup_command(CLI::App* motion, context& ctx);   ///< motion startup (cmd_startup.cpp)

@@ -180,6 +180,7 @@ int main(int argc, char** argv) {
   cli::add_serve_command(app, ctx);
   cli::add_robot_commands(app, ctx);
   cli::add_urdf_command(app, ctx);
+  cli::add_ics_commands(app, ctx);
   cli::add_project_commands(app, ctx);
   cli::add_ui_command(app, ctx);
   app.footer(std::string(footer));  // after the commands: they would inherit it

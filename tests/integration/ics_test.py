@@ -1,0 +1,174 @@
+#!/usr/bin/env python3
+# `rcb4 ics` (issue 34) on `rcb4 ics serve --pty`: scan, ID, EEPROM backup/set/restore, position,
+# temperature, and the refusals (two servos, silent, corrupt, wrong baud, bad values, another
+# servo's backup): exit codes and output, nothing written when refused.
+# SPDX-License-Identifier: BSL-1.0
+import contextlib
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(__file__))
+from checks import check, finish, tool  # noqa: E402
+
+RCB4 = sys.argv[1]
+run, _ = tool(RCB4)
+FACTORY = [n for n in range(1, 65) if 25 <= n <= 26 or 33 <= n <= 50 or 55 <= n <= 56]
+
+
+@contextlib.contextmanager
+def ics_serve(*args):
+    srv = subprocess.Popen([RCB4, "ics", "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
+    try:
+        yield srv.stdout.readline().strip()
+    finally:
+        srv.terminate()
+        srv.wait(timeout=10)
+        check(srv.returncode == 0, f"ics serve {' '.join(args)} ends with 0 on SIGTERM (got {srv.returncode})")
+
+
+def ics(pty, *args, json_out=False):
+    pre = ["--device", pty] + (["--json"] if json_out else [])
+    return run(*pre, "ics", *args)
+
+
+def raw(pty):
+    rc, out, _ = ics(pty, "eeprom", "show", json_out=True)
+    return [int(b, 16) for b in json.loads(out)["raw"].split()] if rc == 0 else None
+
+
+work = tempfile.mkdtemp(prefix="rcb4-ics-")
+os.chdir(work)
+
+with ics_serve() as pty:
+    rc, out, err = ics(pty, "scan", json_out=True)
+    servos = json.loads(out)["servos"] if rc == 0 else []
+    check(rc == 0 and servos == [{"id": 0, "baud": 115200, "ics": "3.6", "stretch": 60, "speed": 127}],
+          f"scan finds the servo: ID 0 at 115200, ICS 3.6 (rc {rc}: {out.strip()} {err.strip()})")
+    first = raw(pty)
+    rc, out, err = ics(pty, "id", "set", "5")
+    check(rc == 0 and "ID 0 -> 5" in out, f"id set 5 (rc {rc}: {out.strip()} {err.strip()})")
+    rc, out, _ = ics(pty, "id", json_out=True)
+    check(rc == 0 and json.loads(out)["id"] == 5, f"--json ics id says 5 ({out.strip()})")
+    rc, out, err = ics(pty, "eeprom", "backup", "a.bin")
+    check(rc == 0 and os.path.getsize("a.bin") == 64, f"eeprom backup a.bin: 64 bytes (rc {rc} {err.strip()})")
+    before = raw(pty)
+    check(before is not None and [before[n - 1] for n in FACTORY] == [first[n - 1] for n in FACTORY],
+          "the ID write left the factory bytes alone")
+    rc, out, err = ics(pty, "--backup-dir", work, "set", "stretch=40", "speed=100")
+    check(rc == 0 and "stretch            60 -> 40" in out and "old image is in" in out,
+          f"set stretch=40 speed=100 (rc {rc}: {out.strip()} {err.strip()})")
+    saved = [f for f in os.listdir(work) if f.startswith("ics-id5-") and f.endswith(".bin")]
+    check(len(saved) == 1 and open(saved[0], "rb").read() == bytes(before),
+          f"set saved the old image first, byte for byte ({saved})")
+    rc, out, _ = ics(pty, "eeprom", "show", json_out=True)
+    shown = json.loads(out) if rc == 0 else {}
+    check(shown.get("stretch") == 40 and shown.get("speed") == 100 and shown.get("id") == 5,
+          f"--json eeprom show names stretch 40 and speed 100 ({out[:120]})")
+    rc, out, _ = ics(pty, "eeprom", "show")
+    check(rc == 0 and "stretch            40" in out and "speed              100" in out, "eeprom show shows both")
+    after_set = raw(pty)
+    check([after_set[n - 1] for n in FACTORY] == [before[n - 1] for n in FACTORY], "set left the factory bytes alone")
+    changed = [n for n in range(1, 65) if after_set[n - 1] != before[n - 1]]
+    check(changed and all(n in (3, 4, 5, 6) for n in changed), f"set changed only bytes 3-6 ({changed})")
+    rc, out, err = ics(pty, "eeprom", "restore", "a.bin")
+    check(rc == 0 and raw(pty) == before and open("a.bin", "rb").read() == bytes(before),
+          f"eeprom restore a.bin brings the image back byte for byte (rc {rc} {err.strip()})")
+    rc, out, _ = ics(pty, "eeprom", "restore", "a.bin", json_out=True)
+    check(rc == 0 and json.loads(out)["written"] is False, "restoring the same image again writes nothing")
+
+    rc, out, err = ics(pty, "position", "30", "--wait", json_out=True)
+    pos = json.loads(out) if rc == 0 else {}
+    check(rc == 0 and abs(pos.get("degrees", 99) - 30) <= 1, f"position 30 --wait: within 1 degree ({out.strip()})")
+    rc, out, _ = ics(pty, "position", json_out=True)
+    check(rc == 0 and abs(json.loads(out)["degrees"] - 30) <= 1, f"position reads 30 degrees ({out.strip()})")
+    rc, out, _ = ics(pty, "position", "8000", json_out=True)
+    check(rc == 0 and json.loads(out)["target"]["counts"] == 8000, "position 8000 is counts")
+    rc, out, _ = ics(pty, "position", "free", json_out=True)
+    check(rc == 0 and json.loads(out)["free"] is True, f"position free ({out.strip()})")
+    rc, out, _ = ics(pty, "temperature", json_out=True)
+    check(rc == 0 and 1 <= json.loads(out)["temperature"] <= 127, f"temperature reads ({out.strip()})")
+    rc, out, _ = ics(pty, "current", json_out=True)
+    check(rc == 0 and "amperes" in json.loads(out), f"current reads ({out.strip()})")
+    rc, out, _ = ics(pty, "stretch", "50", json_out=True)
+    check(rc == 0 and json.loads(out)["stretch"] == 50, "stretch 50 set live")
+
+    # refusals: nothing written
+    now = raw(pty)
+    for args, code, words in [
+        (("set", "stretch=0"), 2, "out of range 1..127"),
+        (("set", "stretch=200"), 2, "out of range"),
+        (("set", "baud=9600"), 2, "115200, 625000 or 1250000"),
+        (("set", "id=3"), 2, "ics id set"),
+        (("set", "nonsense=1"), 2, "expected FIELD=VALUE"),
+        (("set", "stretch=40", "stretch=41"), 2, "given twice"),
+        (("position", "200"), 2, "degrees (-135..135) or counts"),
+        (("position", "north"), 2, "give degrees"),
+        (("--id", "7", "eeprom", "show"), 4, "does not answer"),
+        (("eeprom", "restore", "missing.bin"), 2, "cannot read"),
+    ]:
+        rc, out, err = ics(pty, *args)
+        check(rc == code and words in err, f"{' '.join(args)}: exit {code}, says '{words}' (rc {rc}: {err.strip()})")
+    with open("short.bin", "wb") as f:
+        f.write(bytes(10))
+    rc, _, err = ics(pty, "eeprom", "restore", "short.bin")
+    check(rc == 2 and "holds 10 bytes" in err, f"a 10-byte file is refused ({err.strip()})")
+    check(raw(pty) == now, "nothing was written by the refused commands")
+    rc, _, err = ics(pty, "--baud", "625000", "id")
+    check(rc == 4 and "no ICS servo answers" in err, f"a wrong --baud: exit 4 ({err.strip()})")
+
+# another servo's backup is refused; --force keeps this servo's factory bytes
+with ics_serve("--seed", "7") as pty:
+    mine = raw(pty)
+    rc, out, err = ics(pty, "eeprom", "restore", "a.bin")
+    check(rc == 1 and "another servo" in err and raw(pty) == mine,
+          f"another servo's backup: exit 1, nothing written ({err.strip()})")
+    rc, out, err = ics(pty, "eeprom", "restore", "a.bin", "--force", json_out=True)
+    forced = raw(pty)
+    check(rc == 0 and [forced[n - 1] for n in FACTORY] == [mine[n - 1] for n in FACTORY] and forced[56:58] == mine[56:58],
+          f"--force writes the settings, keeps its factory bytes and ID ({out.strip()} {err.strip()})")
+
+# two servos on one wire: ID work refused, nothing changes
+with ics_serve("--servos", "2") as pty:
+    rc, out, _ = ics(pty, "scan", json_out=True)
+    check(rc == 0 and [s["id"] for s in json.loads(out)["servos"]] == [0, 1], f"scan finds both ({out.strip()})")
+    before0 = ics(pty, "--id", "0", "eeprom", "show", json_out=True)[1]
+    rc, out, err = ics(pty, "id", "set", "5")
+    check(rc == 1 and "more than one device" in err, f"id set with two servos: exit 1 ({err.strip()})")
+    rc, out, _ = ics(pty, "--id", "1", "eeprom", "show", json_out=True)
+    check(rc == 0 and json.loads(out)["id"] == 1, "servo 1 keeps its ID")
+    check(ics(pty, "--id", "0", "eeprom", "show", json_out=True)[1] == before0, "servo 0 unchanged")
+
+with ics_serve("--silent") as pty:
+    rc, _, err = ics(pty, "id")
+    check(rc == 4 and "no ICS servo answers" in err and "ICS mode" in err, f"silent: exit 4 with a hint ({err.strip()})")
+    rc, out, _ = ics(pty, "scan")
+    check(rc == 4 and "no ICS servo answered" in out, "silent: scan finds nothing, exit 4")
+
+with ics_serve("--corrupt") as pty:
+    rc, _, err = ics(pty, "id")
+    check(rc == 1 and "corrupt" in err, f"corrupt ID reply: exit 1 ({err.strip()})")
+    rc, _, err = ics(pty, "--id", "0", "set", "stretch=30")
+    check(rc in (1, 4) and "ics-id0-" not in " ".join(os.listdir(work)), f"corrupt: set refused, nothing saved ({err.strip()})")
+
+with ics_serve("--servo-baud", "1250000", "--ics35", "--servo-id", "3") as pty:
+    rc, out, _ = ics(pty, "scan", json_out=True)
+    check(rc == 0 and json.loads(out)["servos"] == [{"id": 3, "baud": 1250000, "ics": "3.5", "stretch": 60, "speed": 127}],
+          f"scan finds an ICS 3.5 servo at 1.25 M ({out.strip()})")
+    rc, out, err = ics(pty, "eeprom", "show")
+    check(rc == 0 and "ICS servo 3 at 1250000 baud" in out, f"the baud is found without --baud ({err.strip()})")
+    rc, _, err = ics(pty, "position")
+    check(rc == 1 and "ICS 3.5" in err, f"a 3.5 servo's position read is refused with why ({err.strip()})")
+    rc, out, err = ics(pty, "--baud", "1250000", "set", "baud=115200")
+    check(rc == 0 and "now talks at 115200" in out, f"set baud=115200 follows the servo ({out.strip()} {err.strip()})")
+    rc, out, _ = ics(pty, "--baud", "115200", "id", json_out=True)
+    check(rc == 0 and json.loads(out) == {"id": 3, "baud": 115200}, f"it answers at 115200 now ({out.strip()})")
+
+rc, out, err = run("--device", "/dev/nonexistent-ics", "ics", "id")
+check(rc == 3, f"a missing device: exit 3 ({err.strip()})")
+rc, out, _ = run("--json", "ics", "eeprom", "show")
+check(rc == 0 and json.loads(out)["stretch"] == 60, "without --device: the in-process virtual servo")
+
+finish()

@@ -1,0 +1,129 @@
+// The ICS servo service (rcb4/robot/services/ics.hpp) on in-process virtual lines: what it
+// writes, what it refuses, and that a refusal writes nothing.
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/robot/services/ics.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <stdexcept>
+
+using namespace rcb4;
+using namespace rcb4::robot::services;
+using ics::field;
+
+namespace {
+ics::servo_id id_of(unsigned n) { return ics::servo_id::make(n).value(); }
+ics_virtual_link one(unsigned id = 0, std::uint32_t baud = 115200, std::uint32_t seed = 1) {
+  return ics_virtual_link(ics::virtual_line({ics::virtual_servo(id_of(id), baud, seed)}));
+}
+refusal_kind kind_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const refused& r) {
+    return r.kind;
+  }
+  FAIL("not refused");
+  return refusal_kind::usage;
+}
+}  // namespace
+
+TEST_CASE("ics service finds a lone servo's ID and baud", "[ics]") {
+  auto l = one(7, 625000);
+  ics_servo s(l, {}, {});
+  CHECK(s.id() == id_of(7));
+  CHECK(s.baud() == 625000);
+  CHECK(s.read_id() == id_of(7));
+  auto l2 = one(7, 625000);
+  CHECK(kind_of([&] { ics_servo(l2, id_of(3), {}); }) == refusal_kind::timeout);
+  CHECK(kind_of([&] { ics_servo(l2, {}, 115200); }) == refusal_kind::timeout);
+  CHECK(kind_of([&] { ics_servo(l2, {}, 9600); }) == refusal_kind::usage);
+}
+
+TEST_CASE("ics service sets fields: backup first, only those bytes, read back", "[ics]") {
+  auto l = one(4);
+  ics_servo s(l, {}, {});
+  const auto before = s.read_eeprom();
+  int saves = 0;
+  const ics_backup save = [&](const ics::eeprom_image& e) {
+    CHECK(e == before);
+    ++saves;
+    return std::string("saved.bin");
+  };
+  const auto r = s.set_fields({{field::stretch, 40}, {field::reverse, 1}}, save);
+  CHECK(saves == 1);
+  CHECK(r.written);
+  CHECK(r.backup == "saved.bin");
+  CHECK(r.after.get(field::stretch) == 40);
+  CHECK(r.after.get(field::reverse) == 1);
+  CHECK(r.after.same_unit(before));
+  for (std::size_t i = 0; i < 64; ++i)
+    if (i != 2 && i != 3 && i != 15) CHECK(r.after.bytes()[i] == before.bytes()[i]);
+  CHECK(l.line().servos()[0].stretch() == 40);  // the servo took it
+  // the same again: nothing to write, no backup
+  CHECK_FALSE(s.set_fields({{field::stretch, 40}}, save).written);
+  CHECK(saves == 1);
+  // a backup that cannot be saved stops the write
+  const ics_backup fails = [](const ics::eeprom_image&) -> std::string { throw std::runtime_error("disk full"); };
+  CHECK_THROWS_AS(s.set_fields({{field::stretch, 20}}, fails), std::runtime_error);
+  CHECK(s.read_eeprom().get(field::stretch) == 40);
+  CHECK(kind_of([&] { s.set_fields({{field::stretch, 0}}, save); }) == refusal_kind::usage);
+  CHECK(kind_of([&] { s.set_fields({{field::id, 3}}, save); }) == refusal_kind::usage);
+  CHECK(kind_of([&] { s.set_fields({{field::speed, 9}, {field::speed, 10}}, save); }) == refusal_kind::usage);
+  CHECK(saves == 1);
+}
+
+TEST_CASE("ics service restores only onto the same servo unless forced", "[ics]") {
+  auto mine = one(2, 115200, 1);
+  auto other = one(2, 115200, 9);
+  ics_servo a(mine, {}, {});
+  ics_servo b(other, {}, {});
+  const auto theirs = b.read_eeprom();
+  const auto own = a.read_eeprom();
+  const ics_backup save = [](const ics::eeprom_image&) { return std::string("old.bin"); };
+  CHECK(kind_of([&] { a.restore(theirs, false, save); }) == refusal_kind::board);
+  CHECK(a.read_eeprom() == own);
+  auto edited = theirs;
+  REQUIRE(edited.set(field::speed, 50));
+  const auto r = a.restore(edited, true, save);
+  CHECK(r.after.get(field::speed) == 50);
+  CHECK(r.after.same_unit(own));  // its own factory bytes kept
+  CHECK(!r.notes.empty());
+}
+
+TEST_CASE("ics service refuses ID work with two servos and corrupt replies", "[ics]") {
+  ics_virtual_link two(ics::virtual_line({ics::virtual_servo(id_of(0)), ics::virtual_servo(id_of(1), 115200, 2)}));
+  CHECK(kind_of([&] { ics_servo(two, {}, {}); }) == refusal_kind::board);
+  ics_servo s(two, id_of(0), 115200);
+  CHECK(kind_of([&] { s.set_id(id_of(5)); }) == refusal_kind::board);
+  CHECK(two.line().servos()[0].id() == id_of(0));
+  CHECK(two.line().servos()[1].id() == id_of(1));
+  const auto found = ics_scan(two, {}, {});
+  REQUIRE(found.size() == 2);
+  CHECK(found[1].id == id_of(1));
+  CHECK(found[1].ics36);
+
+  ics_virtual_link bad(ics::virtual_line({ics::virtual_servo{}}, ics::line_faults{false, true}));
+  CHECK(kind_of([&] { ics_servo(bad, id_of(0), 115200); }) == refusal_kind::board);
+  ics_virtual_link quiet(ics::virtual_line({ics::virtual_servo{}}, ics::line_faults{true, false}));
+  CHECK(kind_of([&] { ics_servo(quiet, {}, {}); }) == refusal_kind::timeout);
+  CHECK(ics_scan(quiet, {}, {}).empty());
+}
+
+TEST_CASE("ics service: ID set on a lone servo, moves, settings text", "[ics]") {
+  auto l = one(0);
+  ics_servo s(l, {}, {});
+  CHECK(s.set_id(id_of(12)) == id_of(12));
+  CHECK(s.read_eeprom().get(field::id) == 12);
+  CHECK(s.move(8833) == 7500);
+  CHECK(kind_of([&] { s.move(3000); }) == refusal_kind::usage);
+  CHECK(kind_of([&] { s.write(ics::sub::current, 64); }) == refusal_kind::usage);
+  CHECK(s.write(ics::sub::speed, 30) == 30);
+  CHECK(s.read(ics::sub::speed) == 30);
+  CHECK(parse_ics_setting("stretch=40") == std::pair{field::stretch, 40L});
+  CHECK(parse_ics_setting("reverse=on") == std::pair{field::reverse, 1L});
+  CHECK(parse_ics_setting("user_offset=-5") == std::pair{field::user_offset, -5L});
+  CHECK(parse_ics_setting("baud=625000") == std::pair{field::baud, 625000L});
+  for (const char* bad :
+       {"stretch", "stretch=", "stretch=4x", "baud=9600", "free=1", "id=2", "nope=1", "max_limit=7000"})
+    CHECK(kind_of([&] { (void)parse_ics_setting(bad); }) == refusal_kind::usage);
+}

@@ -1,0 +1,390 @@
+// rcb4 command-line tool: `rcb4 ics …`, one ICS servo on a KONDO adapter in ICS mode (ics.md):
+// scan, id, eeprom show|backup|restore, set, position, stretch, speed, current, temperature. The
+// rules are the robot services' (rcb4/robot/services/ics.hpp); this file parses and prints.
+// `rcb4 ics serve` (cmd_ics_serve.cpp) is a virtual servo to try it on.
+// SPDX-License-Identifier: BSL-1.0
+#include "app.hpp"
+
+#include <rcb4/ics/virtual_servo.hpp>
+#include <rcb4/robot/services/ics.hpp>
+#include <rcb4/transport/ics_port.hpp>
+
+#include <cmath>
+
+namespace cli {
+namespace {
+
+namespace sv = rcb4::robot::services;
+namespace ics = rcb4::ics;
+using namespace std::chrono_literals;
+
+/** What `rcb4 ics` takes before its command. */
+struct ics_globals {
+  long long id = -1;             ///< --id, or -1: the one servo on the line
+  long long scan_timeout = 30;   ///< scan: ms per ID
+  std::string backup_dir = ".";  ///< where set and restore save the old image
+};
+
+/** The line: the port --device names, or an in-process virtual servo. */
+class line {
+ public:
+  explicit line(const globals& g) {
+    if (!g.empty_device.empty()) throw failure(exit_usage, g.empty_device);
+    const auto baud = g.baud.value_or(115200);
+    if (g.device.empty()) {
+      virtual_ = std::make_unique<sv::ics_virtual_link>(ics::virtual_line({ics::virtual_servo{}}));
+      virtual_->set_baud(baud);
+      return;
+    }
+    try {
+      port_ = std::make_unique<rcb4::transport::ics_port>(g.device, baud);
+    } catch (const boost::system::system_error& e) {
+      throw explain(std::error_code(e.code()), fmt::format("cannot open {}: {}", g.device, e.code().message()));
+    }
+    link_ = std::make_unique<sv::ics_port_link<rcb4::transport::ics_port>>(*port_);
+  }
+  sv::ics_link& get() { return virtual_ ? static_cast<sv::ics_link&>(*virtual_) : *link_; }
+
+ private:
+  std::unique_ptr<sv::ics_virtual_link> virtual_;
+  std::unique_ptr<rcb4::transport::ics_port> port_;
+  std::unique_ptr<sv::ics_link> link_;
+};
+
+sv::ics_options options_of(const globals& g) {
+  sv::ics_options o;
+  o.timeout = g.timeout;
+  return o;
+}
+
+/** Runs @p f on the servo --id names (or the one on the line), found at --baud or each rate. */
+void on_servo(CLI::App* cmd, context& ctx, const std::shared_ptr<ics_globals>& ig,
+              std::function<int(sv::ics_servo&)> f) {
+  on_run(cmd, ctx, [&ctx, ig, f] {
+    line l(ctx.g);
+    std::optional<ics::servo_id> id;
+    if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
+    sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g));
+    return f(s);
+  });
+}
+
+double deg(std::uint16_t counts) { return std::round(ics::position::degrees(counts) * 100) / 100; }
+
+json position_json(std::uint16_t counts) { return json{{"counts", counts}, {"degrees", deg(counts)}}; }
+
+std::string value_text(ics::field f, long v) {
+  const auto& i = ics::info(f);
+  if (i.nibbles == 0) return v ? "on" : "off";
+  if (f == ics::field::max_limit || f == ics::field::min_limit)
+    return fmt::format("{} ({:+.1f} deg)", v, ics::position::degrees(static_cast<std::uint16_t>(v)));
+  return std::to_string(v);
+}
+
+/** ICSSW p6's temperature points (value, °C), smaller is hotter (ics.md §3; the scales disagree, §7.3). */
+double icssw_celsius(int v) {
+  constexpr std::pair<double, double> pts[] = {{30, 100}, {47, 90}, {60, 80}, {75, 70}, {87, 60}};
+  std::size_t k = 0;
+  while (k + 2 < std::size(pts) && v > pts[k + 1].first) ++k;
+  const auto [x0, y0] = pts[k];
+  const auto [x1, y1] = pts[k + 1];
+  return std::round(y0 + (v - x0) * (y1 - y0) / (x1 - x0));
+}
+
+int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_view what) {
+  if (g.json) {
+    json changed = json::object();
+    for (const auto& [f, v] : r.changed) changed[std::string(ics::info(f).name)] = v;
+    emit(json{{"written", r.written}, {"changed", changed}, {"backup", r.backup}, {"notes", r.notes}});
+    return exit_ok;
+  }
+  if (!r.written) {
+    fmt::print("nothing to change: the EEPROM already holds {}\n", what);
+    return exit_ok;
+  }
+  for (const auto& [f, v] : r.changed)
+    fmt::print("{:<18} {} -> {}\n", ics::info(f).name, value_text(f, r.before.get(f)), value_text(f, v));
+  fmt::print("written and read back (64 bytes equal); the old image is in {}\n", r.backup);
+  for (const auto& n : r.notes) fmt::print("note: {}\n", n);
+  return exit_ok;
+}
+
+int eeprom_show(sv::ics_servo& s, const globals& g) {
+  const auto e = s.read_eeprom();
+  std::string raw;
+  for (auto b : e.bytes()) raw += fmt::format("{}{:02X}", raw.empty() ? "" : " ", b);
+  if (g.json) {
+    json j;
+    for (const auto& i : ics::fields)
+      j[std::string(i.name)] = i.nibbles == 0 ? json(e.get(i.f) != 0) : json(e.get(i.f));
+    j["raw"] = raw;
+    emit(j);
+    return exit_ok;
+  }
+  fmt::print("ICS servo {} at {} baud: EEPROM\n", s.id().value(), s.baud());
+  for (const auto& i : ics::fields) fmt::print("  {:<18} {:<22} {}\n", i.name, value_text(i.f, e.get(i.f)), i.what);
+  fmt::print("  raw {}\n", raw);
+  return exit_ok;
+}
+
+/** "30", "-12.5" (degrees, within ±135), "8833" (counts, 3500-11500). */
+std::uint16_t target_of(const std::string& word) {
+  double v = 0;
+  try {
+    std::size_t used = 0;
+    v = std::stod(word, &used);
+    if (used != word.size()) throw std::invalid_argument(word);
+  } catch (const std::exception&) {
+    throw usage_error(fmt::format("position '{}': give degrees (-135..135), counts (3500..11500) or free", word));
+  }
+  if (std::abs(v) <= 135) return *ics::position::counts(v);
+  if (v >= ics::position::min && v <= ics::position::max && v == std::floor(v)) return static_cast<std::uint16_t>(v);
+  throw usage_error(fmt::format("position {}: give degrees (-135..135) or counts (3500..11500)", word));
+}
+
+int position(sv::ics_servo& s, const std::string& word, bool wait, const globals& g) {
+  json j{{"id", s.id().value()}};
+  if (word.empty()) {
+    const auto p = s.position();
+    j.update(position_json(p));
+    if (g.json)
+      emit(j);
+    else
+      fmt::print("ICS servo {}: {} ({:+.2f} deg)\n", s.id().value(), p, deg(p));
+    return exit_ok;
+  }
+  if (word == "free") {
+    const auto p = s.free();
+    j["free"] = true;
+    j.update(position_json(p));
+    if (g.json)
+      emit(j);
+    else
+      fmt::print("ICS servo {} is free; it stood at {} ({:+.2f} deg)\n", s.id().value(), p, deg(p));
+    return exit_ok;
+  }
+  const auto target = target_of(word);
+  const auto was = s.move(target);
+  j["target"] = position_json(target);
+  j["was"] = position_json(was);
+  std::uint16_t now = was;
+  if (wait) {  // until at the target (3 counts, 0.1 degree), or it stops getting closer
+    const auto deadline = std::chrono::steady_clock::now() + 5s;
+    int still = 0;
+    for (std::uint16_t last = was; std::chrono::steady_clock::now() < deadline && still < 5; last = now) {
+      now = s.position();
+      if (std::abs(now - target) <= 3) break;
+      still = std::abs(now - target) >= std::abs(last - target) ? still + 1 : 0;
+    }
+    j.update(position_json(now));
+  }
+  if (g.json) {
+    emit(j);
+    return exit_ok;
+  }
+  fmt::print("ICS servo {} to {} ({:+.2f} deg); it stood at {} ({:+.2f} deg)\n", s.id().value(), target, deg(target),
+             was, deg(was));
+  if (wait) fmt::print("now at {} ({:+.2f} deg)\n", now, deg(now));
+  return exit_ok;
+}
+
+int parameter(sv::ics_servo& s, ics::sub what, const char* name, const std::string& value, const globals& g) {
+  std::uint8_t v = 0;
+  if (value.empty())
+    v = s.read(what);
+  else
+    v = s.write(what, parse_int(value, name, 1, 127));
+  if (g.json)
+    emit(json{{"id", s.id().value()}, {name, v}, {"set", !value.empty()}});
+  else
+    fmt::print("ICS servo {}: {} {}{}\n", s.id().value(), name, v,
+               value.empty() ? "" : " (set live; the servo may keep it in EEPROM too, ics.md §7.1)");
+  return exit_ok;
+}
+
+void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<ics_globals>& ig) {
+  auto* eeprom = ics_cmd->add_subcommand("eeprom", "the servo's 64-byte EEPROM: show, backup FILE, restore FILE");
+  eeprom->require_subcommand(1);
+  on_servo(eeprom->add_subcommand("show", "every field, decoded (units of ICS Manager: stretch 1-127)"), ctx, ig,
+           [&ctx](sv::ics_servo& s) { return eeprom_show(s, ctx.g); });
+
+  auto file = std::make_shared<std::string>();
+  auto* backup = eeprom->add_subcommand("backup", "save the servo's own 64 bytes to FILE");
+  backup->add_option("FILE", *file, "where (overwritten)")->required();
+  on_servo(backup, ctx, ig, [&ctx, file](sv::ics_servo& s) {
+    const auto e = s.read_eeprom();
+    sv::save_ics_image(*file, e);
+    if (ctx.g.json)
+      emit(json{{"file", *file}, {"id", s.id().value()}, {"baud", s.baud()}});
+    else
+      fmt::print("ICS servo {}'s EEPROM saved to {} (64 bytes)\n", s.id().value(), *file);
+    return exit_ok;
+  });
+
+  auto rfile = std::make_shared<std::string>();
+  auto force = std::make_shared<bool>(false);
+  auto* restore =
+      eeprom->add_subcommand("restore", "write a backup back (this servo's own; its factory bytes are never written)");
+  restore->add_option("FILE", *rfile, "a file from `ics eeprom backup`")->required();
+  restore->add_flag("--force", *force, "write another servo's settings (this servo's factory bytes are kept)");
+  on_servo(restore, ctx, ig, [&ctx, ig, rfile, force](sv::ics_servo& s) {
+    const auto image = sv::load_ics_image(*rfile);
+    return print_report(s.restore(image, *force, sv::ics_backup_in(ig->backup_dir, s.id())), ctx.g, *rfile);
+  });
+}
+
+}  // namespace
+
+void add_ics_serve_command(CLI::App* ics_cmd, context& ctx);
+
+void add_ics_commands(CLI::App& app, context& ctx) {
+  auto ig = std::make_shared<ics_globals>();
+  auto* cmd = app.add_subcommand(
+      "ics",
+      "ICS servos on their own line: a KONDO adapter in ICS mode (--device), one servo with its own supply "
+      "(docs/ics-servos.md); without --device, an in-process virtual servo");
+  cmd->require_subcommand(1);
+  cmd->fallthrough();
+  cmd->add_option("--id", ig->id, "the servo's ID (default: the one servo on the line, by the ID command)")
+      ->check(int_range(0, 31));
+  cmd->add_option("--backup-dir", ig->backup_dir, "where set and eeprom restore save the old image (default .)");
+
+  auto* scan = cmd->add_subcommand("scan", "which servos answer, at which baud and ID (every ID at every rate)");
+  scan->add_option("--scan-timeout", ig->scan_timeout, "ms to wait for each ID (default 30)")
+      ->check(int_range(1, 10000));
+  on_run(scan, ctx, [&ctx, ig] {
+    line l(ctx.g);
+    auto o = options_of(ctx.g);
+    o.timeout = std::chrono::milliseconds(ig->scan_timeout);
+    std::vector<std::uint32_t> bs;
+    if (ctx.g.baud) bs.push_back(*ctx.g.baud);
+    const auto found = sv::ics_scan(l.get(), bs, o, [&ctx](std::uint32_t b) {
+      if (!ctx.g.json) fmt::print(stderr, "scanning IDs 0-31 at {} baud\n", b);
+    });
+    json servos = json::array();
+    json bad = json::array();
+    bool any = false;
+    for (const auto& f : found) {
+      if (!f.problem.empty()) {
+        bad.push_back(json{{"id", f.id.value()}, {"baud", f.baud}, {"problem", f.problem}});
+        continue;
+      }
+      any = true;
+      servos.push_back(json{{"id", f.id.value()},
+                            {"baud", f.baud},
+                            {"ics", f.ics36 ? "3.6" : "3.5"},
+                            {"stretch", f.stretch},
+                            {"speed", f.speed}});
+    }
+    if (ctx.g.json)
+      emit(json{{"servos", servos}, {"garbled", bad}});
+    else if (found.empty())
+      fmt::print("no ICS servo answered\n");
+    for (const auto& f : found)
+      if (ctx.g.json) {
+      } else if (f.problem.empty())
+        fmt::print("ID {:2}  {:>7} baud  ICS {}  stretch {}  speed {}\n", f.id.value(), f.baud,
+                   f.ics36 ? "3.6" : "3.5 (no SC 5 position read)", f.stretch, f.speed);
+      else
+        fmt::print("ID {:2}  {:>7} baud  answers wrongly: {}\n", f.id.value(), f.baud, f.problem);
+    return any ? exit_ok : found.empty() ? exit_timeout : exit_board;
+  });
+
+  auto new_id = std::make_shared<long long>(-1);
+  auto* id = cmd->add_subcommand("id", "the ID of the one servo on the line; `id set N` gives it a new one");
+  auto* id_set = id->add_subcommand("set", "give the servo alone on the line ID N (checked alone first, read back)");
+  id_set->add_option("N", *new_id, "0-31")->required()->check(int_range(0, 31));
+  on_servo(id_set, ctx, ig, [&ctx, new_id](sv::ics_servo& s) {
+    const auto was = s.id();
+    const auto n = s.set_id(ics::servo_id::make(*new_id).value());
+    if (ctx.g.json)
+      emit(json{{"id", n.value()}, {"was", was.value()}});
+    else
+      fmt::print("ID {} -> {} (read back)\n", was.value(), n.value());
+    return exit_ok;
+  });
+
+  // `id` alone reads; its callback runs after `id set`'s, so it leaves set's action alone.
+  id->callback([&ctx, ig, id_set] {
+    if (id_set->parsed()) return;
+    ctx.action = [&ctx, ig] {
+      line l(ctx.g);
+      std::optional<ics::servo_id> want;
+      if (ig->id >= 0) want = ics::servo_id::make(ig->id).value();
+      sv::ics_servo s(l.get(), want, ctx.g.baud, options_of(ctx.g));
+      const auto n = s.read_id();
+      if (ctx.g.json)
+        emit(json{{"id", n.value()}, {"baud", s.baud()}});
+      else
+        fmt::print("{}\n", n.value());
+      return exit_ok;
+    };
+  });
+  add_eeprom_commands(cmd, ctx, ig);
+
+  auto settings = std::make_shared<std::vector<std::string>>();
+  auto* set = cmd->add_subcommand("set", "change EEPROM fields: read, modify, back up, write, read back");
+  set->add_option("FIELD=VALUE", *settings, "e.g. stretch=40 speed=100 reverse=on baud=625000")->required();
+  set->footer(
+      "fields: stretch speed punch dead_band damping safe_timer slave rotation pwm_inhibit reverse max_limit "
+      "min_limit baud temperature_limit current_limit response user_offset stretch_1 stretch_2 stretch_3");
+  on_run(set, ctx, [&ctx, ig, settings] {
+    std::vector<std::pair<ics::field, long>> changes;
+    for (const auto& w : *settings) changes.push_back(sv::parse_ics_setting(w));  // before the line opens
+    line l(ctx.g);
+    std::optional<ics::servo_id> sid;
+    if (ig->id >= 0) sid = ics::servo_id::make(ig->id).value();
+    sv::ics_servo s(l.get(), sid, ctx.g.baud, options_of(ctx.g));
+    return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id())), ctx.g, join(*settings));
+  });
+
+  auto where = std::make_shared<std::string>();
+  auto wait = std::make_shared<bool>(false);
+  auto* pos = cmd->add_subcommand("position", "where it stands (ICS 3.6), or move it: DEG, COUNTS or free");
+  pos->add_option("TARGET", *where, "degrees (-135..135), counts (3500..11500) or free");
+  pos->add_flag("--wait", *wait, "after a move: read until it is there or stops getting closer, 5 s at most (ICS 3.6)");
+  on_servo(pos, ctx, ig, [&ctx, where, wait](sv::ics_servo& s) { return position(s, *where, *wait, ctx.g); });
+
+  for (auto [name, what, help] : {std::tuple{"stretch", ics::sub::stretch, "stiffness 1-127: read, or set live"},
+                                  {"speed", ics::sub::speed, "speed 1-127: read, or set live"}}) {
+    auto value = std::make_shared<std::string>();
+    auto* c = cmd->add_subcommand(name, help);
+    c->add_option("N", *value, "1-127 (none: read)");
+    on_servo(c, ctx, ig,
+             [&ctx, value, what, name](sv::ics_servo& s) { return parameter(s, what, name, *value, ctx.g); });
+  }
+  on_servo(cmd->add_subcommand("current", "the current it draws (about 0.1 A a unit; bit 6 the direction)"), ctx, ig,
+           [&ctx](sv::ics_servo& s) {
+             const auto v = s.read(ics::sub::current);
+             const double amps = (v & 0x3F) / 10.0;
+             if (ctx.g.json)
+               emit(json{{"id", s.id().value()}, {"current", v}, {"amperes", amps}, {"direction", (v >> 6) & 1}});
+             else
+               fmt::print("ICS servo {}: current {} (about {:.1f} A, direction {})\n", s.id().value(), v, amps,
+                          (v >> 6) & 1);
+             return exit_ok;
+           });
+  on_servo(cmd->add_subcommand("temperature", "its temperature value 1-127 (smaller is hotter)"), ctx, ig,
+           [&ctx](sv::ics_servo& s) {
+             const auto v = s.read(ics::sub::temperature);
+             if (ctx.g.json)
+               emit(json{{"id", s.id().value()}, {"temperature", v}, {"celsius_icssw", icssw_celsius(v)}});
+             else
+               fmt::print(
+                   "ICS servo {}: temperature {} (about {:.0f} C on KONDO's ICS 3.5 manual's scale; the "
+                   "scales disagree: docs/ics-servos.md)\n",
+                   s.id().value(), v, icssw_celsius(v));
+             return exit_ok;
+           });
+  add_ics_serve_command(cmd, ctx);
+  // Options of `ics` and the global ones may follow the command words too (rcb4 ics eeprom show --id 3).
+  const std::function<void(CLI::App*)> through = [&through](CLI::App* a) {
+    for (auto* c : a->get_subcommands({})) {
+      c->fallthrough();
+      through(c);
+    }
+  };
+  through(cmd);
+}
+
+}  // namespace cli
