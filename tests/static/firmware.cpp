@@ -1,6 +1,7 @@
 // Built with -fno-exceptions -fno-rtti (and, where present, arm-none-eabi-g++ -mcpu=cortex-m4):
-// the whole codec in firmware. Only <rcb4/rcb4.hpp> is included.
+// the whole codec in firmware: <rcb4/rcb4.hpp> and the ICS servo codec <rcb4/ics/commands.hpp>.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/ics/commands.hpp>
 #include <rcb4/rcb4.hpp>
 
 // What a microcontroller does: build a frame into a static buffer and parse the reply.
@@ -14,4 +15,18 @@ extern "C" unsigned rcb4_firmware_probe(const unsigned char* rx, unsigned rx_len
   auto r = parse_reply(std::span<const std::uint8_t>(rx, rx_len), expected_reply(*c));
   auto p = parse_command(std::span<const std::uint8_t>(rx, rx_len));
   return static_cast<unsigned>(n.value_or(0) + r.consumed + p.consumed);
+}
+
+// A microcontroller that sets up an ICS servo: read its EEPROM, change the stretch, write it back.
+extern "C" unsigned rcb4_firmware_ics_probe(const unsigned char* rx, unsigned rx_len, unsigned char* tx) {
+  using namespace rcb4::ics;
+  const auto id = servo_id::make(rx_len % 32).value();
+  const read_eeprom read(id);
+  const auto got = parse_exchange(read, std::span<const std::uint8_t>(rx, rx_len));
+  if (!got.ok()) return 0;
+  auto image = got.value;
+  if (!image.set(field::stretch, 40)) return 0;
+  const auto f = write_eeprom(id, image).request();
+  for (std::size_t i = 0; i < f.size; ++i) tx[i] = f.data[i];
+  return static_cast<unsigned>(f.size);
 }

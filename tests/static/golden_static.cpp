@@ -3,6 +3,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "golden.hpp"
 
+#include <rcb4/ics/commands.hpp>
+
 #include <algorithm>
 #include <variant>
 
@@ -59,4 +61,19 @@ static_assert(expected_reply(command{move::read_ram(0x0090, 126).value()}).frame
 // Fixed-size commands serialize into std::array of exactly their length.
 static_assert(to_array(ret{}) == std::array<std::uint8_t, 3>{0x03, 0x0D, 0x10});
 static_assert(to_array(call{0x000B80}) == std::array<std::uint8_t, 7>{0x07, 0x0C, 0x80, 0x0B, 0x00, 0x00, 0x9E});
+
+// The ICS codec at compile time: ics.md §2.4's worked examples, written by hand.
+constexpr bool ics_same(const ics::frame& f, std::initializer_list<std::uint8_t> want) {
+  return f.size == want.size() && std::equal(want.begin(), want.end(), f.data.begin());
+}
+constexpr auto ics_id(unsigned n) { return ics::servo_id::make(n).value(); }
+static_assert(ics_same(ics::set_position::make(ics_id(3), 8833).value().request(), {0x83, 0x45, 0x01}));
+static_assert(ics_same(ics::read_parameter::make(ics_id(12), ics::sub::temperature).value().request(), {0xAC, 0x04}));
+static_assert(ics_same(ics::write_id(ics_id(9)).request(), {0xE9, 0x01, 0x01, 0x01}));
+static_assert(ics::parse_exchange(ics::read_id{}, std::array<std::uint8_t, 5>{0xFF, 0x00, 0x00, 0x00, 0xEC}).value ==
+              ics_id(12));
+static_assert(ics::parse_exchange(ics::set_position::make(ics_id(3), 8833).value(),
+                                  std::array<std::uint8_t, 6>{0x83, 0x45, 0x01, 0x03, 0x3A, 0x4E})
+                  .value == 7502);
+static_assert(ics::position::counts(45.0).value() == 8833);
 }  // namespace
