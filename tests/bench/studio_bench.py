@@ -32,33 +32,44 @@ try:
     f1, s1, t1 = d.execute_script("return [window.rcb4Studio.view.stats.frames, window.rcb4State.seq, performance.now()]")
     secs = (t1 - t0) / 1000
     lat = []
+    acked = []
     for k in range(12):
         target = 20 if k % 2 == 0 else -20
         ms = d.execute_async_script("""
             const [name, deg, i, done] = arguments;
             const s = document.querySelector(`.joint[data-joint="${name}"] input[type=range]`);
             const before = window.rcb4State.targets[i];
+            const acked = window.rcb4State.link.move_at_ms;
             const t0 = performance.now();
+            let board = null;
             s.value = deg; s.dispatchEvent(new Event('input'));
             const poll = () => {
               // The first state whose output for the joint has left where it was: the board has the move
               // (it then interpolates toward the target at the server's speed limit).
               const st = window.rcb4State;
-              if (st && st.targets[i] !== null && Math.abs(st.targets[i] - before) > 0.2) done(performance.now() - t0);
+              // The board acknowledged the move (the server's wall clock against the page's).
+              if (board === null && st.link.move_at_ms !== null && st.link.move_at_ms !== acked)
+                board = st.link.move_at_ms - (performance.timeOrigin + t0);
+              if (st && st.targets[i] !== null && Math.abs(st.targets[i] - before) > 0.2) done([performance.now() - t0, board]);
               else if (performance.now() - t0 > 5000) done(null);
               else setTimeout(poll, 1);
             };
             poll();""", "head_yaw", target, names.index("head_yaw"))
         if ms is not None:
-            lat.append(ms)
+            lat.append(ms[0])
+            if ms[1] is not None:
+                acked.append(ms[1])
         time.sleep(0.6)
     period = d.execute_script("return window.rcb4Studio.hello.period_ms")
     print(f"3D view: {(f1 - f0) / secs:.1f} frames/s while the board is read {(s1 - s0) / secs:.1f} times/s "
           f"(the page's period {period} ms)")
+    if acked:
+        print(f"slider -> the board has the move (its ACK): median {statistics.median(acked):.1f} ms, max {max(acked):.1f} ms "
+              f"over {len(acked)} moves")
     if lat:
         print(f"slider -> the board moving the joint: median {statistics.median(lat):.1f} ms, max {max(lat):.1f} ms over {len(lat)} "
-              f"moves (the first move of a drag goes at once, later ones every 40 ms; the board loop takes it at its "
-              f"next cycle and the board is read every {period} ms)")
+              f"moves (the first move of a drag goes at once, later ones every 40 ms; the board loop wakes for it, and "
+              f"reads the board one output period after it, when the board has taken its first step)")
 finally:
     d.quit()
     ui.stop()

@@ -55,22 +55,38 @@ class loop {
 
   void run() {
     bool lists_sent = false;
+    bool joints_next = false;
+    auto poll_at = clock::now();
     while (!h_.stopped()) {
-      const auto start = clock::now();
-      for (auto& a : h_.take()) {
+      const auto actions = h_.take();
+      bool moved = false;
+      for (const auto& a : actions) {
         if (h_.stopped()) return;
+        moved = moved || std::holds_alternative<move_action>(a.body);
         carry_out(a);
       }
       if (h_.stopped()) return;
       if (auto done = studio_.tick()) h_.tell(done->to, done->text);  // a motion played from the host
-      poll();
-      if (answering_ && !lists_sent) {  // after the first state: a page shows the robot at once
-        refresh_lists();
-        lists_sent = true;
+      // After a slider move the board shows it once it has taken its first step, one output period
+      // on: the page hears then, not a page period later. Other work is shown at once.
+      if (moved && answering_) {
+        poll_at = clock::now() + std::chrono::milliseconds(rcb4::milliseconds(period_)) + 2ms;
+        joints_next = true;  // that read only needs the joints
+      } else if (!actions.empty()) {
+        poll_at = clock::now();
+        joints_next = false;
       }
-      const auto pause = answering_ ? o_.period : 500ms;  // a silent board is tried twice a second
+      if (clock::now() >= poll_at) {
+        const auto start = clock::now();
+        poll(std::exchange(joints_next, false));
+        if (answering_ && !lists_sent) {  // after the first state: a page shows the robot at once
+          refresh_lists();
+          lists_sent = true;
+        }
+        poll_at = start + (answering_ ? o_.period : 500ms);  // a silent board is tried twice a second
+      }
       // A motion played from the host wakes the loop when its next pose is due, not a poll later.
-      const auto wake = std::min(start + pause, studio_.due().value_or(start + pause));
+      const auto wake = std::min(poll_at, studio_.due().value_or(poll_at));
       if (!h_.wait_until(wake)) break;
     }
   }
@@ -84,7 +100,8 @@ class loop {
   }
 
   // --- reading -------------------------------------------------------------------------------
-  void poll() {
+  /** Reads the robot and sends the state; @p joints_only (the read after a slider move) keeps the rest as last read. */
+  void poll(bool joints_only = false) {
     t::error_code ec;
     if (!reader_) locate(ec);
     if (!ec) {
@@ -93,9 +110,10 @@ class loop {
     }
     std::optional<ops::analog_inputs> analog;
     std::optional<ops::motion_state> motion;
-    if (!ec) analog = run_ec(ops::read_analog{}, ec);
-    if (!ec) motion = run_ec(ops::read_motion_state(*o_.layout), ec);
-    if (!ec) {
+    joints_only = joints_only && answering_;
+    if (!ec && !joints_only) analog = run_ec(ops::read_analog{}, ec);
+    if (!ec && !joints_only) motion = run_ec(ops::read_motion_state(*o_.layout), ec);
+    if (!ec && !joints_only) {
       const auto cfg = run_ec(ops::read_config{}, ec);
       rom_program_ = cfg.rom_program;
       period_ = cfg.period;
@@ -118,8 +136,8 @@ class loop {
                     : !rs[i].answered() ? "silent"
                                         : "on";
       }
-      motion_ = *motion;
-      analog_ = *analog;
+      if (motion) motion_ = *motion;
+      if (analog) analog_ = *analog;
     }
     h_.observe(targets_, angles_, slowest());
     h_.set_state(state_text());
@@ -186,6 +204,9 @@ class loop {
     link["errors"] = k.errors.load();
     link["timeouts"] = k.timeouts.load();
     link["nacks"] = k.nacks.load();
+    // When the board acknowledged the last joint move (wall clock, ms since 1970): a page compares it
+    // with performance.timeOrigin + performance.now() to time a slider change to the board.
+    link["move_at_ms"] = move_at_ms_ ? json(std::round(*move_at_ms_ * 10) / 10) : json(nullptr);
     j["link"] = std::move(link);
     return text_of(j);
   }
@@ -325,6 +346,8 @@ class loop {
     t::error_code ec;
     s_.run_steps(op, ec, [] {});
     if (ec) throw refusal{words_of(ec, "move")};
+    move_at_ms_ =
+        std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
     std::chrono::milliseconds longest{0};
     for (const auto& mv : op.value())
       longest = std::max(longest, std::chrono::milliseconds(mv.frames * rcb4::milliseconds(op.period())));
@@ -538,6 +561,7 @@ class loop {
   ops::motion_state motion_{};
   bool rom_program_ = false;
   rcb4::output_period period_ = rcb4::output_period::ms10;
+  std::optional<double> move_at_ms_;  // when the board acknowledged the last move (system clock, ms)
   std::vector<ops::motion_slot> motions_;
   bool answering_ = false;
   std::string error_;

@@ -322,6 +322,12 @@ std::optional<action> controller::due_move(clock::time_point now) {
   return action{from, id, std::move(mv)};
 }
 
+std::optional<clock::time_point> controller::move_due_at() const {
+  if (pending_.empty()) return std::nullopt;
+  if (!last_move_) return clock::time_point::min();
+  return *last_move_ + settings_.move_interval;
+}
+
 void controller::observe(std::span<const std::optional<double>> targets, std::span<const std::optional<double>> angles,
                          std::chrono::milliseconds longest) {
   for (std::size_t i = 0; i < observed_.size() && i < targets.size(); ++i) observed_[i] = targets[i];

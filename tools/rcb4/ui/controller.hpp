@@ -124,6 +124,8 @@ class controller {
   effects receive(client_id c, std::string_view text, clock::time_point now);
   /** The gathered slider moves, when one is due at @p now (at most one per move_interval). */
   std::optional<action> due_move(clock::time_point now);
+  /** When due_move will next give a move: nothing when no slider move waits (the board loop wakes then). */
+  std::optional<clock::time_point> move_due_at() const;
   /**
    * The board's latest reading, one entry per model joint: the target angle (nothing when free,
    * held or unknown) and the measured angle (nothing when silent), and the longest move the

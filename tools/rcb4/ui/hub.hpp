@@ -56,6 +56,7 @@ class hub {
       std::lock_guard lock(mutex_);
       absorb(controller_.receive(c, text, clock::now()), out);
     }
+    cv_.notify_all();  // a slider move may be due now
     deliver(out);
   }
 
@@ -68,12 +69,18 @@ class hub {
     return out;
   }
   /**
-   * Waits until @p deadline, or less: when an action is queued or the hub stops (slider moves
-   * wait for the next cycle). Returns false once stopped.
+   * Waits until @p deadline, or less: when an action is queued, a slider move falls due (a drag's
+   * first move at once, then one a move interval) or the hub stops. Returns false once stopped.
    */
   bool wait_until(clock::time_point deadline) {
     std::unique_lock lock(mutex_);
-    cv_.wait_until(lock, deadline, [&] { return stopped_ || !queue_.empty(); });
+    for (;;) {
+      if (stopped_ || !queue_.empty()) break;
+      const auto due = controller_.move_due_at();
+      const auto until = due ? std::min(deadline, *due) : deadline;
+      if (clock::now() >= until) break;
+      cv_.wait_until(lock, until);  // receive() wakes it when a page sends
+    }
     return !stopped_;
   }
   /** The board's targets and angles, per model joint, and its longest move (see controller::observe). */
