@@ -292,17 +292,17 @@ read back after a write. Use it as a context manager, or call close().)");
           "The EEPROM's 64 bytes as read (each 0..15: one nibble a byte), checked.")
       .def(
           "backup",
-          [](ics_device& d, const py::object& path) {
+          [](ics_device& d, const py::object& path, bool force) {
             const auto p = path_of(path);
             const auto [id, baud] = d.run("backup", [&](sv::ics_servo& s) {
-              sv::save_ics_image(p, s.read_eeprom());
+              sv::save_ics_image(p, s.read_eeprom(), force);
               return std::pair{s.id().value(), s.baud()};
             });
             return py::dict("file"_a = p, "id"_a = id, "baud"_a = baud);
           },
-          "path"_a,
-          "Saves the servo's own 64 EEPROM bytes to path (replaced if it exists), as `rcb4 ics eeprom backup` does; "
-          "returns {file, id, baud}.")
+          "path"_a, "force"_a = false,
+          "Saves the servo's own 64 EEPROM bytes to path, as `rcb4 ics eeprom backup` does (UsageError when path "
+          "exists, unless force=True); returns {file, id, baud}.")
       .def(
           "restore",
           [](ics_device& d, const py::object& path, bool force, const py::object& backup_dir) {
@@ -322,7 +322,7 @@ read back after a write. Use it as a context manager, or call close().)");
           "differed), notes}.")
       .def(
           "set",
-          [](ics_device& d, const py::object& backup_dir, const py::kwargs& fields) {
+          [](ics_device& d, const py::object& backup_dir, bool force, const py::kwargs& fields) {
             const auto dir = path_of(backup_dir);
             if (fields.empty()) throw board_error(fault::usage, "set: give fields, e.g. set(stretch=40, speed=100)");
             std::vector<std::string> words;
@@ -333,15 +333,16 @@ read back after a write. Use it as a context manager, or call close().)");
             } catch (const sv::refused& e) {
               raise_refusal(e, "set");
             }
-            const auto r =
-                d.run("set", [&](sv::ics_servo& s) { return s.set_fields(changes, sv::ics_backup_in(dir, s.id())); });
+            const auto r = d.run(
+                "set", [&](sv::ics_servo& s) { return s.set_fields(changes, sv::ics_backup_in(dir, s.id()), force); });
             return report_dict(r);
           },
-          "backup_dir"_a = ".",
+          "backup_dir"_a = ".", "force"_a = false,
           "Changes EEPROM fields, e.g. set(stretch=40, speed=100, reverse=True): checked first (UsageError, nothing "
           "read or written, for an unknown field, id or free, or a value out of range), then read, the old image "
           "saved to backup_dir/ics-idN-STAMP.bin, written, read back. Returns {written, changed, backup, notes} as "
-          "restore() does; set(baud=...) moves the line to the new rate (a note says so).")
+          "restore() does; set(baud=...) moves the line to the new rate (a note says so). slave=True (the servo "
+          "never answers again) is refused unless force=True.")
       .def(
           "move",
           [](ics_device& d, const py::object& degrees, const py::object& counts) {

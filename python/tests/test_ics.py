@@ -354,3 +354,19 @@ def test_opening_is_checked():
             pyrcb4.IcsServo(**kwargs)
     with pytest.raises(pyrcb4.ArgumentError, match="set_id"):
         pyrcb4.IcsServo().set_id()
+
+
+def test_backup_never_replaces_a_file_unless_forced(servo, tmp_path):
+    kept = tmp_path / "a.bin"
+    servo.backup(kept)
+    with pytest.raises(pyrcb4.UsageError, match="exists"):
+        servo.backup(kept)
+    assert servo.backup(kept, force=True)["file"] == str(kept)
+
+
+def test_slave_flag_needs_force(servo, tmp_path):
+    before = servo.eeprom_bytes()
+    with pytest.raises(pyrcb4.UsageError, match="never answer"):
+        servo.set(backup_dir=tmp_path, slave=True)
+    assert servo.eeprom_bytes() == before
+    assert backups(tmp_path) == []

@@ -77,7 +77,30 @@ with ics_serve() as pty:
     check(rc == 0 and raw(pty) == before and open("a.bin", "rb").read() == bytes(before),
           f"eeprom restore a.bin brings the image back byte for byte (rc {rc} {err.strip()})")
     rc, out, _ = ics(pty, "eeprom", "restore", "a.bin", json_out=True)
-    check(rc == 0 and json.loads(out)["written"] is False, "restoring the same image again writes nothing")
+    check(rc == 0 and json.loads(out)["written"] is False and json.loads(out)["backup"] is None,
+          f"restoring the same image again writes nothing, no backup ({out.strip()})")
+    rc, out, _ = ics(pty, "set", "reverse=on", json_out=True)
+    check(rc == 0 and json.loads(out)["changed"] == {"reverse": True}, f"--json set: a flag is a bool ({out.strip()})")
+    check(ics(pty, "eeprom", "restore", "a.bin")[0] == 0, "restore after reverse=on")
+    rc, out, _ = ics(pty, "id", "set", "5")
+    check(rc == 0 and "already" in out, f"id set 5 on ID 5: nothing written ({out.strip()})")
+    rc, _, err = ics(pty, "eeprom", "backup", "a.bin")
+    check(rc == 2 and "exists" in err and open("a.bin", "rb").read() == bytes(before),
+          f"eeprom backup onto an existing file is refused ({err.strip()})")
+    rc, _, err = ics(pty, "eeprom", "backup", "a.bin", "--force")
+    check(rc == 0, f"eeprom backup --force replaces it ({err.strip()})")
+    rc, _, err = run("--device", pty, "--trace", "ics", "temperature")
+    check(rc == 0 and "->" in err and "A5 04" in err and "<-" in err and "25 04" in err,
+          f"--trace shows the exchanges ({err.strip()[:200]})")
+    # damaged backups: a field beyond its range, an unknown baud code
+    good = open("a.bin", "rb").read()
+    with open("stretch0.bin", "wb") as f:
+        f.write(good[:2] + bytes([0, 0]) + good[4:])
+    with open("baud5.bin", "wb") as f:
+        f.write(good[:27] + bytes([5]) + good[28:])
+    for name, words in (("stretch0.bin", "stretch is 0, beyond 1..127"), ("baud5.bin", "baud code is 5")):
+        rc, _, err = ics(pty, "eeprom", "restore", name)
+        check(rc == 2 and words in err and raw(pty) == before, f"restore {name}: exit 2, nothing written ({err.strip()})")
 
     rc, out, err = ics(pty, "position", "30", "--wait", json_out=True)
     pos = json.loads(out) if rc == 0 else {}
@@ -103,6 +126,8 @@ with ics_serve() as pty:
         (("set", "baud=9600"), 2, "115200, 625000 or 1250000"),
         (("set", "id=3"), 2, "ics id set"),
         (("set", "nonsense=1"), 2, "expected FIELD=VALUE"),
+        (("set", "reverse=maybe"), 2, "give on or off"),
+        (("set", "slave=on"), 2, "never answer again"),
         (("set", "stretch=40", "stretch=41"), 2, "given twice"),
         (("position", "200"), 2, "degrees (-135..135) or counts"),
         (("position", "north"), 2, "give degrees"),
@@ -140,6 +165,8 @@ with ics_serve("--servos", "2") as pty:
     rc, out, _ = ics(pty, "--id", "1", "eeprom", "show", json_out=True)
     check(rc == 0 and json.loads(out)["id"] == 1, "servo 1 keeps its ID")
     check(ics(pty, "--id", "0", "eeprom", "show", json_out=True)[1] == before0, "servo 0 unchanged")
+    rc, _, err = ics(pty, "eeprom", "show")
+    check(rc == 1 and "--id N" in err, f"eeprom show with two servos and no --id: the hint names --id ({err.strip()})")
 
 with ics_serve("--silent") as pty:
     rc, _, err = ics(pty, "id")
@@ -161,10 +188,21 @@ with ics_serve("--servo-baud", "1250000", "--ics35", "--servo-id", "3") as pty:
     check(rc == 0 and "ICS servo 3 at 1250000 baud" in out, f"the baud is found without --baud ({err.strip()})")
     rc, _, err = ics(pty, "position")
     check(rc == 1 and "ICS 3.5" in err, f"a 3.5 servo's position read is refused with why ({err.strip()})")
+    rc, _, err = ics(pty, "position", "40", "--wait")
+    rc2, out, _ = ics(pty, "position", "free", json_out=True)
+    check(rc == 1 and "ICS 3.5" in err and rc2 == 0 and json.loads(out)["counts"] == 7500,
+          f"position --wait on a 3.5 servo is refused before it moves ({err.strip()} {out.strip()})")
     rc, out, err = ics(pty, "--baud", "1250000", "set", "baud=115200")
     check(rc == 0 and "now talks at 115200" in out, f"set baud=115200 follows the servo ({out.strip()} {err.strip()})")
     rc, out, _ = ics(pty, "--baud", "115200", "id", json_out=True)
     check(rc == 0 and json.loads(out) == {"id": 3, "baud": 115200}, f"it answers at 115200 now ({out.strip()})")
+
+# slave=on with --force: written, and the servo never answers again
+with ics_serve("--servo-id", "2") as pty:
+    rc, out, err = ics(pty, "set", "slave=on", "--force")
+    check(rc == 0 and "slave now" in out, f"set slave=on --force writes it, says so ({out.strip()} {err.strip()})")
+    rc, _, err = ics(pty, "id")
+    check(rc == 4, f"then the servo never answers ({err.strip()})")
 
 rc, out, err = run("--device", "/dev/nonexistent-ics", "ics", "id")
 check(rc == 3, f"a missing device: exit 3 ({err.strip()})")

@@ -10,6 +10,7 @@
 #include <rcb4/transport/ics_port.hpp>
 
 #include <cmath>
+#include <thread>
 
 namespace cli {
 namespace {
@@ -28,8 +29,9 @@ struct ics_globals {
 /** The line: the port --device names, or an in-process virtual servo. */
 class line {
  public:
-  explicit line(const globals& g) {
-    if (!g.empty_device.empty()) throw failure(exit_usage, g.empty_device);
+  explicit line(const globals& g) : trace_(g.trace) {
+    if (!g.empty_device.empty())
+      throw failure(exit_usage, "--device is empty: name the adapter's port, or leave it out for a virtual servo");
     const auto baud = g.baud.value_or(115200);
     if (g.device.empty()) {
       virtual_ = std::make_unique<sv::ics_virtual_link>(ics::virtual_line({ics::virtual_servo{}}));
@@ -43,9 +45,46 @@ class line {
     }
     link_ = std::make_unique<sv::ics_port_link<rcb4::transport::ics_port>>(*port_);
   }
-  sv::ics_link& get() { return virtual_ ? static_cast<sv::ics_link&>(*virtual_) : *link_; }
+  sv::ics_link& get() {
+    sv::ics_link& inner = virtual_ ? static_cast<sv::ics_link&>(*virtual_) : *link_;
+    if (!trace_) return inner;
+    if (!traced_) traced_ = std::make_unique<tracer>(inner);
+    return *traced_;
+  }
 
  private:
+  /** --trace: every exchange on stderr, time, rate, bytes out and in. */
+  class tracer final : public sv::ics_link {
+   public:
+    explicit tracer(sv::ics_link& inner) : in_(inner), start_(std::chrono::steady_clock::now()) {}
+    std::vector<std::uint8_t> transact(std::span<const std::uint8_t> request, std::size_t expect,
+                                       std::chrono::milliseconds wait) override {
+      print("->", request);
+      auto rx = in_.transact(request, expect, wait);
+      print(rx.size() < expect ? "<- (short)" : "<-", rx);
+      return rx;
+    }
+    std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) override {
+      auto rx = in_.linger(wait);
+      if (!rx.empty()) print("<- (late)", rx);
+      return rx;
+    }
+    void set_baud(std::uint32_t baud) override { in_.set_baud(baud); }
+    std::uint32_t baud() const override { return in_.baud(); }
+
+   private:
+    void print(std::string_view dir, std::span<const std::uint8_t> b) const {
+      std::string hex;
+      for (auto x : b) hex += fmt::format(" {:02X}", x);
+      fmt::print(stderr, "{:10.3f} ms  {:>7}  {:<10}{}\n",
+                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count(),
+                 in_.baud(), dir, hex);
+    }
+    sv::ics_link& in_;
+    std::chrono::steady_clock::time_point start_;
+  };
+  bool trace_ = false;
+  std::unique_ptr<tracer> traced_;
   std::unique_ptr<sv::ics_virtual_link> virtual_;
   std::unique_ptr<rcb4::transport::ics_port> port_;
   std::unique_ptr<sv::ics_link> link_;
@@ -94,12 +133,17 @@ double icssw_celsius(int v) {
 int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_view what) {
   if (g.json) {
     json changed = json::object();
-    for (const auto& [f, v] : r.changed) changed[std::string(ics::info(f).name)] = v;
-    emit(json{{"written", r.written}, {"changed", changed}, {"backup", r.backup}, {"notes", r.notes}});
+    for (const auto& [f, v] : r.changed)
+      changed[std::string(ics::info(f).name)] = ics::info(f).nibbles == 0 ? json(v != 0) : json(v);
+    emit(json{{"written", r.written},
+              {"changed", changed},
+              {"backup", r.backup.empty() ? json(nullptr) : json(r.backup)},
+              {"notes", r.notes}});
     return exit_ok;
   }
   if (!r.written) {
     fmt::print("nothing to change: the EEPROM already holds {}\n", what);
+    for (const auto& n : r.notes) fmt::print("note: {}\n", n);
     return exit_ok;
   }
   for (const auto& [f, v] : r.changed)
@@ -164,27 +208,40 @@ int position(sv::ics_servo& s, const std::string& word, bool wait, const globals
     return exit_ok;
   }
   const auto target = target_of(word);
+  if (wait) (void)s.position();  // --wait reads the position (ICS 3.6): a 3.5 servo is refused before it moves
   const auto was = s.move(target);
   j["target"] = position_json(target);
   j["was"] = position_json(was);
   std::uint16_t now = was;
-  if (wait) {  // until at the target (3 counts, 0.1 degree), or it stops getting closer
-    const auto deadline = std::chrono::steady_clock::now() + 5s;
-    int still = 0;
-    for (std::uint16_t last = was; std::chrono::steady_clock::now() < deadline && still < 5; last = now) {
+  bool there = true;
+  if (wait) {  // read every 20 ms until there (3 counts, 0.1 degree), 5 s at most, or no closer for 0.5 s
+    const auto start = std::chrono::steady_clock::now();
+    auto closer_at = start;
+    int best = std::abs(was - target);
+    for (;;) {
       now = s.position();
-      if (std::abs(now - target) <= 3) break;
-      still = std::abs(now - target) >= std::abs(last - target) ? still + 1 : 0;
+      const int off = std::abs(now - target);
+      const auto t = std::chrono::steady_clock::now();
+      if (off < best) best = off, closer_at = t;
+      if (off <= 3 || t - start > 5s || t - closer_at > 500ms) break;
+      std::this_thread::sleep_for(20ms);  // the servo's pace: a read every 20 ms is enough
     }
+    there = std::abs(now - target) <= ics::position::counts_per_degree;
     j.update(position_json(now));
+    j["arrived"] = there;
   }
-  if (g.json) {
+  if (g.json)
     emit(j);
-    return exit_ok;
+  else {
+    fmt::print("ICS servo {} to {} ({:+.2f} deg); it stood at {} ({:+.2f} deg)\n", s.id().value(), target, deg(target),
+               was, deg(was));
+    if (wait) fmt::print("now at {} ({:+.2f} deg)\n", now, deg(now));
   }
-  fmt::print("ICS servo {} to {} ({:+.2f} deg); it stood at {} ({:+.2f} deg)\n", s.id().value(), target, deg(target),
-             was, deg(was));
-  if (wait) fmt::print("now at {} ({:+.2f} deg)\n", now, deg(now));
+  if (!there)
+    throw failure(exit_board,
+                  fmt::format("ICS servo {} stopped {:.1f} deg short of the target", s.id().value(),
+                              std::abs(deg(now) - deg(target))),
+                  "a load or an obstacle, its limits (rcb4 ics eeprom show: min_limit, max_limit) or a low speed");
   return exit_ok;
 }
 
@@ -198,7 +255,7 @@ int parameter(sv::ics_servo& s, ics::sub what, const char* name, const std::stri
     emit(json{{"id", s.id().value()}, {name, v}, {"set", !value.empty()}});
   else
     fmt::print("ICS servo {}: {} {}{}\n", s.id().value(), name, v,
-               value.empty() ? "" : " (set live; the servo may keep it in EEPROM too, ics.md §7.1)");
+               value.empty() ? "" : " (set live; the servo may keep it in EEPROM too: docs/ics-servos.md)");
   return exit_ok;
 }
 
@@ -210,10 +267,12 @@ void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<
 
   auto file = std::make_shared<std::string>();
   auto* backup = eeprom->add_subcommand("backup", "save the servo's own 64 bytes to FILE");
-  backup->add_option("FILE", *file, "where (overwritten)")->required();
-  on_servo(backup, ctx, ig, [&ctx, file](sv::ics_servo& s) {
+  auto replace = std::make_shared<bool>(false);
+  backup->add_option("FILE", *file, "where (an existing file is refused)")->required();
+  backup->add_flag("--force", *replace, "replace FILE if it exists");
+  on_servo(backup, ctx, ig, [&ctx, file, replace](sv::ics_servo& s) {
     const auto e = s.read_eeprom();
-    sv::save_ics_image(*file, e);
+    sv::save_ics_image(*file, e, *replace);
     if (ctx.g.json)
       emit(json{{"file", *file}, {"id", s.id().value()}, {"baud", s.baud()}});
     else
@@ -226,7 +285,8 @@ void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<
   auto* restore =
       eeprom->add_subcommand("restore", "write a backup back (this servo's own; its factory bytes are never written)");
   restore->add_option("FILE", *rfile, "a file from `ics eeprom backup`")->required();
-  restore->add_flag("--force", *force, "write another servo's settings (this servo's factory bytes are kept)");
+  restore->add_flag("--force", *force,
+                    "write another servo's settings (this servo's factory bytes are kept), or a slave flag");
   on_servo(restore, ctx, ig, [&ctx, ig, rfile, force](sv::ics_servo& s) {
     const auto image = sv::load_ics_image(*rfile);
     return print_report(s.restore(image, *force, sv::ics_backup_in(ig->backup_dir, s.id())), ctx.g, *rfile);
@@ -298,7 +358,9 @@ void add_ics_commands(CLI::App& app, context& ctx) {
     const auto was = s.id();
     const auto n = s.set_id(ics::servo_id::make(*new_id).value());
     if (ctx.g.json)
-      emit(json{{"id", n.value()}, {"was", was.value()}});
+      emit(json{{"id", n.value()}, {"was", was.value()}, {"written", was != n}});
+    else if (was == n)
+      fmt::print("the servo is ID {} already: nothing written\n", n.value());
     else
       fmt::print("ID {} -> {} (read back)\n", was.value(), n.value());
     return exit_ok;
@@ -323,19 +385,22 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   add_eeprom_commands(cmd, ctx, ig);
 
   auto settings = std::make_shared<std::vector<std::string>>();
+  auto set_force = std::make_shared<bool>(false);
   auto* set = cmd->add_subcommand("set", "change EEPROM fields: read, modify, back up, write, read back");
   set->add_option("FIELD=VALUE", *settings, "e.g. stretch=40 speed=100 reverse=on baud=625000")->required();
+  set->add_flag("--force", *set_force, "write a setting that stops the servo answering (slave=on)");
   set->footer(
       "fields: stretch speed punch dead_band damping safe_timer slave rotation pwm_inhibit reverse max_limit "
       "min_limit baud temperature_limit current_limit response user_offset stretch_1 stretch_2 stretch_3");
-  on_run(set, ctx, [&ctx, ig, settings] {
+  on_run(set, ctx, [&ctx, ig, settings, set_force] {
     std::vector<std::pair<ics::field, long>> changes;
     for (const auto& w : *settings) changes.push_back(sv::parse_ics_setting(w));  // before the line opens
     line l(ctx.g);
     std::optional<ics::servo_id> sid;
     if (ig->id >= 0) sid = ics::servo_id::make(ig->id).value();
     sv::ics_servo s(l.get(), sid, ctx.g.baud, options_of(ctx.g));
-    return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id())), ctx.g, join(*settings));
+    return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id()), *set_force), ctx.g,
+                        join(*settings));
   });
 
   auto where = std::make_shared<std::string>();

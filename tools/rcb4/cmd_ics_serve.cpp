@@ -34,7 +34,7 @@ struct serve_options {
 int serve(const serve_options& o) {
   if (!o.pty) throw usage_error("ics serve: give --pty");
   if (o.id + o.servos - 1 > ics::servo_id::max)
-    throw usage_error(fmt::format("--id {} with --servos {}: the IDs run past 31", o.id, o.servos));
+    throw usage_error(fmt::format("--servo-id {} with --servos {}: the IDs run past 31", o.id, o.servos));
   std::vector<ics::virtual_servo> servos;
   for (long long k = 0; k < o.servos; ++k)
     servos.emplace_back(ics::servo_id::make(o.id + k).value(), o.baud, static_cast<std::uint32_t>(o.seed + k),

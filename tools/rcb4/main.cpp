@@ -148,13 +148,13 @@ int main(int argc, char** argv) {
       "");
   device->check(not_an_option);
   std::uint32_t baud = 0;
-  app.add_option("--baud", baud, "115200, 625000 or 1250000 (default: detected by ping)")
+  app.add_option("--baud", baud, "115200, 625000 or 1250000 (default: detected: a ping, or an ICS servo's answer)")
       ->type_name("B")
       ->check(CLI::Validator(
           [](std::string& v) -> std::string {
             // The board's COM rates (protocol.md §9); anything else cannot reach it.
             if (v == "115200" || v == "625000" || v == "1250000") return {};
-            return fmt::format("{}: the RCB-4 speaks 115200, 625000 or 1250000", v);
+            return fmt::format("{}: the RCB-4 and ICS servos speak 115200, 625000 or 1250000", v);
           },
           "{115200,625000,1250000}"));
   long long timeout_ms = 100;

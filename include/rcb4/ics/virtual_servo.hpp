@@ -97,6 +97,7 @@ class virtual_servo {
    * for it). A baud written to the EEPROM applies to the next frame (after this reply).
    */
   void answer(std::span<const std::uint8_t> f, line_time t, std::vector<std::uint8_t>& out) {
+    if (image_.get(field::slave) != 0) return;  // a slave never answers (model: nor takes anything)
     const std::uint8_t me = id().value();
     const auto put = [&out](std::initializer_list<std::uint8_t> b) { out.insert(out.end(), b); };
     if (auto c = read_id::parse(f)) {

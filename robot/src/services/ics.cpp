@@ -118,8 +118,11 @@ ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional
     const ics::read_id c;
     const auto req = c.request();
     auto rx = l_.transact(req.view(), req.size + 1, wait_for(req.size + 1, b, o_.timeout));
-    if (rx.size() <= req.size) continue;  // nothing at this rate
-    id_ = read_id();                      // the full check: one clean answer, nothing after it
+    if (rx.size() <= req.size) {  // nothing at this rate: let a late answer pass before the next rate
+      (void)l_.linger(o_.timeout);
+      continue;
+    }
+    id_ = read_id(false);  // the full check: one clean answer, nothing after it
     return;
   }
   throw refused(refusal_kind::timeout,
@@ -128,7 +131,7 @@ ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional
                 hint_wiring);
 }
 
-ics::servo_id ics_servo::read_id() {
+ics::servo_id ics_servo::read_id(bool for_id_write) {
   const ics::read_id c;
   const auto req = c.request();
   std::vector<std::uint8_t> rx;
@@ -153,18 +156,20 @@ ics::servo_id ics_servo::read_id() {
                   fmt::format("more than one device answers {} (received {}): the ID command talks to every "
                               "device on the line",
                               where, hex(rx)),
-                  "leave one servo alone on the adapter for ID work (ics.md §1)");
+                  for_id_write ? "leave one servo alone on the adapter for ID work (docs/ics-servos.md)"
+                               : "name the servo with --id N (`rcb4 ics scan` lists them)");
   return p.value;
 }
 
 ics::servo_id ics_servo::set_id(ics::servo_id id) {
-  const auto alone = read_id();
+  const auto alone = read_id(true);
   if (alone != id_)
     throw refused(
         refusal_kind::board,
         fmt::format("the one servo on the line answers as ID {}, not {}: nothing written", alone.value(), id_.value()));
+  if (alone == id) return id_;  // already: nothing to write
   (void)ask(ics::write_id(id), o_.write_timeout, "ID write");
-  const auto now = read_id();
+  const auto now = read_id(true);
   if (now != id)
     throw refused(
         refusal_kind::board,
@@ -214,13 +219,21 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
                   r.backup);
   }
   r.written = true;
+  if (want.get(field::slave) != 0) {  // it no longer answers: nothing can be read back
+    r.after = want;
+    r.notes.push_back(
+        "the servo is a slave now: it never answers; only the other servo of its back-to-back pair "
+        "(same ID, reverse) answers for it");
+    return r;
+  }
   const auto new_baud = static_cast<std::uint32_t>(want.get(field::baud));
   if (new_baud != old_baud) {
     l_.set_baud(new_baud);
     r.notes.push_back(fmt::format(
-        "the servo now talks at {} baud (was {}): give --baud {}; an RCB-4 reaches its servos at the ICS rate of "
-        "its config word (protocol.md §6), so change both together",
-        new_baud, old_baud, new_baud));
+        "the servo now talks at {} baud (was {}): rcb4 finds the new rate by itself (--baud {} skips the search); "
+        "an RCB-4 reaches its servos at its own ICS rate (`rcb4 config set ics-baud={} --persist`): change both "
+        "together",
+        new_baud, old_baud, new_baud, new_baud));
   }
   try {
     r.after = read_eeprom();
@@ -240,8 +253,19 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
   return r;
 }
 
-ics_eeprom_report ics_servo::set_fields(const std::vector<std::pair<ics::field, long>>& changes,
-                                        const ics_backup& save) {
+namespace {
+/** Refuses an image that would make the servo stop answering, unless @p force. */
+void check_silence(const ics::eeprom_image& before, const ics::eeprom_image& want, bool force) {
+  if (force || want.get(field::slave) == 0 || before.get(field::slave) != 0) return;
+  throw refused(refusal_kind::usage,
+                "slave=on makes the servo never answer again: no tool could read or change it alone (it is for the "
+                "second servo of a back-to-back pair); nothing written",
+                "--force writes it anyway");
+}
+}  // namespace
+
+ics_eeprom_report ics_servo::set_fields(const std::vector<std::pair<ics::field, long>>& changes, const ics_backup& save,
+                                        bool force) {
   if (changes.empty()) throw refused(refusal_kind::usage, "nothing to set: give FIELD=VALUE");
   for (std::size_t i = 0; i < changes.size(); ++i) {
     const auto& inf = ics::info(changes[i].first);
@@ -256,6 +280,7 @@ ics_eeprom_report ics_servo::set_fields(const std::vector<std::pair<ics::field, 
   const auto before = read_eeprom();
   auto want = before;
   for (const auto& [f, v] : changes) (void)want.set(f, v);
+  check_silence(before, want, force);
   return write_image(before, want, save);
 }
 
@@ -267,6 +292,22 @@ ics_eeprom_report ics_servo::restore(const ics::eeprom_image& image, bool force,
                               "55-56) differ from ICS servo {}'s; nothing written",
                               id_.value()),
                   "--force writes its settings but keeps this servo's own factory bytes");
+  // A backup is checked like `set`: no field beyond its range unless the servo holds that value now.
+  for (const auto& i : ics::fields) {
+    if (!i.writable || i.nibbles == 0) continue;
+    const long v = image.get(i.f);
+    if (v == before.get(i.f)) continue;
+    ics::eeprom_image probe;
+    if (!probe.set(i.f, v))
+      throw refused(refusal_kind::usage,
+                    i.f == field::baud ? fmt::format("the backup's baud code is {} (10, 1 or 0 expected): a damaged "
+                                                     "or hand-edited file; nothing written",
+                                                     -v)
+                                       : fmt::format("the backup's {} is {}, beyond {}..{}: a damaged or hand-edited "
+                                                     "file; nothing written",
+                                                     i.name, v, i.min, i.max));
+  }
+  check_silence(before, image, force);
   auto r = write_image(before, image, save);
   if (image.get(field::id) != id_.value())
     r.notes.push_back(
@@ -357,7 +398,10 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
   return found;
 }
 
-void save_ics_image(const std::string& path, const ics::eeprom_image& image) {
+void save_ics_image(const std::string& path, const ics::eeprom_image& image, bool replace) {
+  if (!replace && std::filesystem::exists(path))
+    throw refused(refusal_kind::usage, fmt::format("{} exists: a backup does not replace a file", path),
+                  "another name, or --force to replace it");
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(image.bytes().data()), ics::eeprom_image::size);
   out.close();
@@ -416,7 +460,8 @@ std::pair<ics::field, long> parse_ics_setting(std::string_view text) {
   else {
     const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
     if (ec != std::errc{} || p != v.data() + v.size() || v.empty())
-      throw refused(refusal_kind::usage, fmt::format("{}: '{}' is not a number", inf->name, v));
+      throw refused(refusal_kind::usage, inf->nibbles == 0 ? fmt::format("{}: '{}': give on or off", inf->name, v)
+                                                           : fmt::format("{}: '{}' is not a number", inf->name, v));
   }
   ics::eeprom_image probe;
   if (!probe.set(inf->f, value))

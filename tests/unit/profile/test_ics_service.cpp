@@ -5,7 +5,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <stdexcept>
+#include <string>
 
 using namespace rcb4;
 using namespace rcb4::robot::services;
@@ -126,4 +130,44 @@ TEST_CASE("ics service: ID set on a lone servo, moves, settings text", "[ics]") 
   for (const char* bad :
        {"stretch", "stretch=", "stretch=4x", "baud=9600", "free=1", "id=2", "nope=1", "max_limit=7000"})
     CHECK(kind_of([&] { (void)parse_ics_setting(bad); }) == refusal_kind::usage);
+}
+
+TEST_CASE("ics service refuses damaged backups and a slave flag unless forced", "[ics]") {
+  auto l = one(3);
+  ics_servo s(l, {}, {});
+  const auto before = s.read_eeprom();
+  const ics_backup save = [](const ics::eeprom_image&) { return std::string("old.bin"); };
+  auto damaged = before;
+  REQUIRE(damaged.set_raw(3, 0));  // stretch 0: beyond 1..127
+  REQUIRE(damaged.set_raw(4, 0));
+  CHECK(kind_of([&] { s.restore(damaged, true, save); }) == refusal_kind::usage);
+  auto odd_baud = before;
+  REQUIRE(odd_baud.set_raw(28, 5));
+  CHECK(kind_of([&] { s.restore(odd_baud, true, save); }) == refusal_kind::usage);
+  CHECK(s.read_eeprom() == before);
+  CHECK(kind_of([&] { s.set_fields({{field::slave, 1}}, save); }) == refusal_kind::usage);
+  CHECK(s.read_eeprom() == before);
+  CHECK(s.set_id(id_of(3)) == id_of(3));  // already: nothing written
+  const auto r = s.set_fields({{field::slave, 1}}, save, true);
+  CHECK(r.written);
+  CHECK(!r.notes.empty());
+  CHECK(kind_of([&] { (void)s.read_eeprom(); }) == refusal_kind::timeout);  // a slave never answers
+}
+
+TEST_CASE("ics backups never replace a file unless asked", "[ics]") {
+  const auto dir = std::filesystem::temp_directory_path() / ("rcb4-ics-unit-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const ics::virtual_servo servo(id_of(1));
+  const auto path = (dir / "a.bin").string();
+  save_ics_image(path, servo.image());
+  CHECK(load_ics_image(path) == servo.image());
+  CHECK(kind_of([&] { save_ics_image(path, servo.image()); }) == refusal_kind::usage);
+  save_ics_image(path, servo.image(), true);
+  const auto in = ics_backup_in(dir.string(), id_of(1));
+  const auto first = in(servo.image());
+  const auto second = in(servo.image());
+  CHECK(first != second);  // the same second: -2
+  CHECK(std::filesystem::exists(first));
+  CHECK(std::filesystem::exists(second));
+  std::filesystem::remove_all(dir);
 }

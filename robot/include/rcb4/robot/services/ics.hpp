@@ -95,8 +95,11 @@ using ics_backup = std::function<std::string(const ics::eeprom_image&)>;
  */
 ics_backup ics_backup_in(const std::string& dir, ics::servo_id id);
 
-/** Writes the raw 64 bytes of @p image to @p path (a backup: the servo's own image, byte for byte); throws refused. */
-void save_ics_image(const std::string& path, const ics::eeprom_image& image);
+/**
+ * Writes the raw 64 bytes of @p image to @p path (a backup: the servo's own image, byte for byte);
+ * refused (usage) when it cannot, or when @p path exists and not @p replace.
+ */
+void save_ics_image(const std::string& path, const ics::eeprom_image& image, bool replace = false);
 /** Reads a backup written by save_ics_image (64 bytes, every byte ≤ 0x0F, the check mark); a bad one is refused
  * (usage). */
 ics::eeprom_image load_ics_image(const std::string& path);
@@ -120,18 +123,30 @@ class ics_servo {
   /** The rate it answers at. */
   std::uint32_t baud() const noexcept { return l_.baud(); }
 
-  /** The ID the one device on the line answers with; refused (board) when more than one answers. */
-  ics::servo_id read_id();
-  /** Gives the servo alone on the line the ID @p id: checked first (one device, the one found), then read back. */
+  /**
+   * The ID the one device on the line answers with; refused (board) when more than one answers
+   * (@p for_id_write: the hint says to leave one servo alone, else to name it with --id).
+   */
+  ics::servo_id read_id(bool for_id_write = true);
+  /**
+   * Gives the servo alone on the line the ID @p id: checked first (one device, the one found),
+   * then read back; nothing is written when it has that ID already.
+   */
   ics::servo_id set_id(ics::servo_id id);
 
   /** The EEPROM image, checked (nibbles, check mark, its ID field the servo's own). */
   ics::eeprom_image read_eeprom();
-  /** Sets @p changes (ranges checked before anything is read), saving the old image first. */
-  ics_eeprom_report set_fields(const std::vector<std::pair<ics::field, long>>& changes, const ics_backup& save);
   /**
-   * Writes @p image back: refused (board) when its factory bytes are another servo's unless
-   * @p force; the servo's own factory bytes and ID are kept in any case.
+   * Sets @p changes (ranges checked before anything is read), saving the old image first. A change
+   * that makes the servo stop answering (slave on) is refused (usage) unless @p force.
+   */
+  ics_eeprom_report set_fields(const std::vector<std::pair<ics::field, long>>& changes, const ics_backup& save,
+                               bool force = false);
+  /**
+   * Writes @p image back: refused (board) when its factory bytes are another servo's, and (usage)
+   * when it would make the servo stop answering (slave on), unless @p force; refused (usage) when a
+   * field is beyond its range and not the servo's value now (a damaged file). The servo's own
+   * factory bytes and ID are kept in any case.
    */
   ics_eeprom_report restore(const ics::eeprom_image& image, bool force, const ics_backup& save);
 
