@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <system_error>
 
 namespace rcb4::robot::services {
 namespace {
@@ -48,6 +49,12 @@ std::string hex(std::span<const std::uint8_t> b) {
 const std::string hint_wiring =
     "check the adapter is in ICS mode (the Dual USB Adapter HS's LED red), the servo has its own supply and was "
     "powered after the adapter was opened, and its baud (--baud, or let rcb4 try all three)";
+
+/** The error code of a line failure: a std::system_error's own, else an I/O error. */
+std::error_code line_code(const std::exception& e) {
+  if (const auto* se = dynamic_cast<const std::system_error*>(&e)) return se->code();
+  return std::make_error_code(std::errc::io_error);
+}
 
 /** What `transact` should wait for: both directions' wire time, then the reply allowance. */
 std::chrono::milliseconds wait_for(std::size_t bytes, std::uint32_t baud, std::chrono::milliseconds allowance) {
@@ -217,6 +224,15 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
                               "restore {}`)",
                               r.backup, r.backup),
                   r.backup);
+  } catch (
+      const std::exception& e) {  // the line failed (unplugged): say what may have happened, and where the backup is
+    throw refused(
+        refusal_kind::line,
+        fmt::format("the line failed during the EEPROM write ({}); the servo may or may not have taken the "
+                    "new image",
+                    e.what()),
+        fmt::format("the old image is in {} (`rcb4 ics eeprom restore {}` once the servo answers)", r.backup, r.backup),
+        r.backup, line_code(e));
   }
   r.written = true;
   if (want.get(field::slave) != 0) {  // it no longer answers: nothing can be read back
@@ -240,6 +256,10 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
   } catch (refused& e) {
     throw refused(e.kind, fmt::format("the EEPROM was written, but reading it back failed: {}", e.what()),
                   fmt::format("the old image is in {}", r.backup), r.backup);
+  } catch (const std::exception& e) {
+    throw refused(refusal_kind::line,
+                  fmt::format("the EEPROM was written, but the line failed reading it back ({})", e.what()),
+                  fmt::format("the old image is in {}", r.backup), r.backup, line_code(e));
   }
   if (r.after != want) {
     std::string diff;

@@ -171,3 +171,32 @@ TEST_CASE("ics backups never replace a file unless asked", "[ics]") {
   CHECK(std::filesystem::exists(second));
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("ics service: a line that fails during the EEPROM write names the backup", "[ics]") {
+  struct unplugged final : ics_link {
+    ics_virtual_link inner{ics::virtual_line({ics::virtual_servo{}})};
+    bool pulled = false;
+    std::vector<std::uint8_t> transact(std::span<const std::uint8_t> request, std::size_t expect,
+                                       std::chrono::milliseconds wait) override {
+      if (pulled || (request.size() == 66)) {  // the EEPROM write: the cable comes out
+        pulled = true;
+        throw std::system_error(std::make_error_code(std::errc::io_error), "write");
+      }
+      return inner.transact(request, expect, wait);
+    }
+    std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) override { return inner.linger(wait); }
+    void set_baud(std::uint32_t baud) override { inner.set_baud(baud); }
+    std::uint32_t baud() const override { return inner.baud(); }
+  } l;
+  ics_servo s(l, {}, {});
+  const ics_backup save = [](const ics::eeprom_image&) { return std::string("kept.bin"); };
+  try {
+    (void)s.set_fields({{field::stretch, 30}}, save);
+    FAIL("not refused");
+  } catch (const refused& r) {
+    CHECK(r.kind == refusal_kind::line);
+    CHECK(r.backup == "kept.bin");
+    CHECK(r.code == std::errc::io_error);
+    CHECK(std::string(r.what()).find("may or may not") != std::string::npos);
+  }
+}
