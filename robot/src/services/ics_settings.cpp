@@ -1,0 +1,94 @@
+// rcb4 — robot services: ICS EEPROM backups on disk and settings typed as text. See
+// rcb4/robot/services/ics.hpp.
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/robot/services/ics.hpp>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace rcb4::robot::services {
+
+using ics::field;
+
+void save_ics_image(const std::string& path, const ics::eeprom_image& image, bool replace) {
+  if (!replace && std::filesystem::exists(path))
+    throw refused(refusal_kind::usage, fmt::format("{} exists: a backup does not replace a file", path),
+                  "another name, or --force to replace it");
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(image.bytes().data()), ics::eeprom_image::size);
+  out.close();
+  if (!out)
+    throw refused(refusal_kind::usage, fmt::format("cannot write {}: {}", path, std::strerror(errno)),
+                  "nothing was written to the servo");
+}
+
+ics_backup ics_backup_in(const std::string& dir, ics::servo_id id) {
+  return [dir, id](const ics::eeprom_image& e) {
+    const auto stamp = file_stamp();
+    auto path = fmt::format("{}/ics-id{}-{}.bin", dir, id.value(), stamp);
+    for (int k = 2; std::filesystem::exists(path); ++k)
+      path = fmt::format("{}/ics-id{}-{}-{}.bin", dir, id.value(), stamp, k);
+    save_ics_image(path, e);
+    return path;
+  };
+}
+
+ics::eeprom_image load_ics_image(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw refused(refusal_kind::usage, fmt::format("cannot read {}: {}", path, std::strerror(errno)));
+  const std::vector<std::uint8_t> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (raw.size() != ics::eeprom_image::size)
+    throw refused(
+        refusal_kind::usage,
+        fmt::format("{} holds {} bytes; an ICS EEPROM backup is 64 (`rcb4 ics eeprom backup FILE`)", path, raw.size()));
+  auto e = ics::eeprom_image::parse(raw);
+  if (!e)
+    throw refused(refusal_kind::usage,
+                  fmt::format("{} is no ICS EEPROM image: {} (first bytes {})", path, rcb4::message(e.error()),
+                              fmt::format("{:02X}", fmt::join(std::span(raw).first(8), " "))));
+  return *e;
+}
+
+std::pair<ics::field, long> parse_ics_setting(std::string_view text) {
+  const auto eq = text.find('=');
+  const auto name = text.substr(0, eq);
+  const auto* inf = ics::find_field(name);
+  if (eq == std::string_view::npos || !inf) {
+    std::string names;
+    for (const auto& i : ics::fields)
+      if (i.writable) names += fmt::format("{}{}", names.empty() ? "" : ", ", i.name);
+    throw refused(refusal_kind::usage, fmt::format("'{}': expected FIELD=VALUE with a field of {}", text, names));
+  }
+  if (!inf->writable)
+    throw refused(refusal_kind::usage,
+                  fmt::format("{} cannot be set{}", inf->name,
+                              inf->f == field::id ? ": use `rcb4 ics id set N` (the ID command, one servo alone)"
+                                                  : " (the servo reports it)"));
+  const auto v = text.substr(eq + 1);
+  long value = 0;
+  if (inf->nibbles == 0 && (v == "on" || v == "true" || v == "yes"))
+    value = 1;
+  else if (inf->nibbles == 0 && (v == "off" || v == "false" || v == "no"))
+    value = 0;
+  else {
+    const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
+    if (ec != std::errc{} || p != v.data() + v.size() || v.empty())
+      throw refused(refusal_kind::usage, inf->nibbles == 0 ? fmt::format("{}: '{}': give on or off", inf->name, v)
+                                                           : fmt::format("{}: '{}' is not a number", inf->name, v));
+  }
+  ics::eeprom_image probe;
+  if (!probe.set(inf->f, value))
+    throw refused(refusal_kind::usage, inf->f == field::baud ? fmt::format("baud={}: 115200, 625000 or 1250000", value)
+                                                             : fmt::format("{}={}: out of range {}..{}", inf->name,
+                                                                           value, inf->min, inf->max));
+  return {inf->f, value};
+}
+
+}  // namespace rcb4::robot::services
