@@ -14,14 +14,15 @@ import rospy
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from sensor_msgs.msg import BatteryState, JointState
 from std_msgs.msg import String, UInt8
-from std_srvs.srv import Trigger, TriggerResponse
+from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 import pyrcb4
 from rcb4_ros import actions
+from rcb4_ros.requests import Requests
+from rcb4_ros.trajectory import Trajectories
 
-
-class Rcb4Node:
+class Rcb4Node(Trajectories, Requests):
     """The node: parameters ~device (empty: the in-process virtual board), ~baud, ~robot, ~rate
     (default: one cycle per board output period), ~joint_prefix, ~timeout."""
 
@@ -109,31 +110,7 @@ class Rcb4Node:
         except pyrcb4.UsageError as e:
             rospy.logwarn("rcb4: no robot_description: %s", e)
 
-    # --- callbacks: check, queue, never touch the line ----------------------------------------------
-    def degrees_of(self, names, positions, what):
-        """Degrees for every joint (NaN: not given), or a refusal naming the joint and the limit."""
-        if len(names) != len(positions):
-            raise ValueError(f"{what}: {len(names)} names but {len(positions)} positions")
-        targets = numpy.full(len(self.names), numpy.nan)
-        for name, rad in zip(names, positions):
-            i = self.index.get(name)
-            if i is None:
-                follows = next((self.prefix + self.names[j] for m, j, _, _ in self.mimics if m == name), None)
-                if follows:
-                    raise ValueError(f"{what}: {name} follows {follows} (mimic: no servo of its own): command {follows}")
-                raise ValueError(f"{what}: no joint is called '{name}'")
-            if not math.isnan(targets[i]):
-                raise ValueError(f"{what}: {name} is given twice")
-            if not math.isfinite(rad):
-                raise ValueError(f"{what}: {name}: {rad} is not a position")
-            deg = math.degrees(rad)
-            lower, upper = self.limits[self.names[i]]
-            if not (lower - 1e-6 <= deg <= upper + 1e-6):
-                raise ValueError(f"{what}: {name}: {deg:.2f} degrees is beyond its "
-                                 f"{'lower' if deg < lower else 'upper'} limit {lower if deg < lower else upper:g}")
-            targets[i] = deg
-        return targets
-
+    # --- callbacks: check, queue, never touch the line (trajectory.py, requests.py) ----------------
     def refuse(self, text):
         """One line per refused command; the same refusal again within a second is not repeated."""
         now = time.monotonic()
@@ -143,311 +120,9 @@ class Rcb4Node:
             if len(self.refused_at) > 100:  # forget the old ones
                 self.refused_at = {k: v for k, v in self.refused_at.items() if now - v < 1.0}
 
-    def stop_now(self, why="stopped (~stop, an empty trajectory or a cancel): the joints hold where they are"):
-        """Stop: what is under way is dropped and every joint that moves holds where it is now."""
-        with self.lock:
-            self.trajectory = []
-            self.stream = None
-            self.halt = True
-            self.generation += 1
-            self.replaced_by = why
-
-    def move_refusal(self):
-        """Why a move would fight a ROM motion now (the one rule, through pyrcb4), or None."""
-        return pyrcb4.move_refusal(self.last_motion or {})
-
-    def follow(self, names, points, stamp=0.0):
-        """Replaces what is under way by the trajectory @p points [(time_from_start s, positions rad)]
-        of joints @p names, from @p stamp (ROS time; 0: now); ValueError when a point does not check.
-        Returns its generation (it changes when something else replaces or stops it)."""
-        moves, last = [], 0.0
-        before = self.angles.copy()  # where the first segment starts: the joints as last read
-        for k, (t, positions) in enumerate(points):
-            targets = self.degrees_of(names, positions, f"point {k}")
-            if t < last:
-                raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
-            moves += self.segment(last, t, before, targets)
-            before, last = targets, t
-        begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
-        with self.lock:  # a newer trajectory replaces what is left of the old one
-            self.trajectory = [(begin + at, targets, frames) for at, targets, frames in moves]
-            self.stream = None
-            self.generation += 1
-            self.replaced_by = "replaced by a newer trajectory or command"
-            self.replacing = {i for _, t, _ in self.trajectory for i in numpy.flatnonzero(~numpy.isnan(t))}
-            return self.generation
-
-    def on_trajectory(self, msg):
-        if not msg.points:  # an empty trajectory: stop, every joint holds where it is now
-            self.stop_now()
-            return
-        stamp = msg.header.stamp.to_sec() if msg.header.stamp and not msg.header.stamp.is_zero() else 0.0
-        try:
-            self.follow(msg.joint_names, [(p.time_from_start.to_sec(), p.positions) for p in msg.points], stamp)
-        except ValueError as e:
-            self.refuse(f"trajectory refused, nothing moves: {e}")
-
-    def segment(self, t0, t1, before, targets):
-        """The moves that take the joints from @p before (degrees at t0) to @p targets at t1:
-        [(start time, targets, frames)]. A move lasts at most 255 board periods, so a longer segment
-        becomes equal moves along the same straight line, as the board interpolates it (a joint
-        whose start is unknown, NaN, moves in the last of them only)."""
-        frames = round((t1 - t0) / self.period)
-        if t1 <= t0:
-            return [(t0, targets, 0)]
-        pieces = max(1, math.ceil(frames / 255))
-        moves = []
-        for j in range(1, pieces + 1):
-            at = targets if j == pieces else before + (targets - before) * (j / pieces)
-            n = max(1, round(frames * j / pieces) - round(frames * (j - 1) / pieces))
-            moves.append((t0 + (t1 - t0) * (j - 1) / pieces, at, n))
-        return moves
-
-    def on_joint_command(self, msg):
-        try:
-            targets = self.degrees_of(msg.name, msg.position, "joint_command")
-        except ValueError as e:
-            self.refuse(f"joint_command refused, nothing moves: {e}")
-            return
-        with self.lock:
-            self.stream = targets
-            self.generation += 1
-            self.replaced_by = "replaced by a joint_command"
-            self.replacing = set(int(i) for i in numpy.flatnonzero(~numpy.isnan(targets)))
-            # The joints it names leave the trajectory under way; the others go on with it.
-            named = ~numpy.isnan(targets)
-            rest = []
-            for at, t, frames in self.trajectory:
-                t = t.copy()
-                t[named] = numpy.nan
-                if not numpy.isnan(t).all():
-                    rest.append((at, t, frames))
-            self.trajectory = rest
-
-    def some_joints(self, what, names):
-        """~free_joints / ~hold_joints: an empty message names nothing (~free and ~hold are for all)."""
-        if not names.replace(",", " ").split():
-            self.refuse(f"~{what}_joints: the message names no joint, so nothing was done (~{what} is for every joint)")
-            return
-        self.queue(what, names)
-
-    def queue(self, what, argument, reply=None):
-        self.requests.put((what, argument, reply))
-
-    def ask(self, what, argument, timeout=2.0):
-        """Has the loop thread do @p what and waits for it: (ok, message)."""
-        done = threading.Event()
-        result = {}
-        self.queue(what, argument, (done, result))
-        if not done.wait(timeout):
-            result["abandoned"] = True  # not carried out later, when nobody waits for it any more
-            return False, f"the board did not answer in {timeout:g} s: nothing was done"
-        return result.get("ok", False), result.get("message", "")
-
-    def trigger(self, what, argument):
-        return TriggerResponse(*self.ask(what, argument))
-
     # --- the loop: the only thread on the line ------------------------------------------------------
-    def carry_out(self):
-        while True:
-            try:
-                what, argument, reply = self.requests.get_nowait()
-            except queue.Empty:
-                return
-            ok, message = True, ""
-            if reply and reply[1].get("abandoned"):
-                rospy.logwarn("rcb4: %s: dropped, its caller gave up waiting (the board did not answer)", what)
-                continue
-            try:
-                if what == "hold_some":
-                    names = [self.names[i] for i in argument if not self.freed[i]]
-                    if names:
-                        self.board.hold(*names)
-                    for i in argument:
-                        self.moves.pop(i, None)
-                    message = f"held {len(names)} joints"
-                elif what in ("free", "hold"):
-                    names = [n[len(self.prefix):] if n.startswith(self.prefix) else n
-                             for n in (argument or "").replace(",", " ").split()]
-                    done = (self.board.free if what == "free" else self.board.hold)(*names)
-                    for n in done:
-                        self.freed[self.names.index(n)] = what == "free"
-                        self.moves.pop(self.names.index(n), None)
-                    # What was under way for a freed joint is dropped (this thread writes nothing in
-                    # between): its next point would power the joint again.
-                    dropped = self.drop([self.names.index(n) for n in done]) if what == "free" else []
-                    message = f"{what}: {len(done)} joints"
-                    if what == "free" and dropped:
-                        message += f" (what was under way for {', '.join(dropped)} is dropped)"
-                        rospy.logwarn("rcb4: %s", message)
-                elif what == "halt":
-                    self.stop_now()
-                    message = "stopped: every joint holds where it is"
-                elif what == "resume":
-                    self.board.resume_motion()
-                    message = "the ROM program runs again"
-                elif what == "play":
-                    self.board.play_motion(int(argument), wait=False)
-                    message = f"playing motion {argument}"
-                elif what == "stop":
-                    self.board.stop_motion()
-                    message = "motion stopped"
-                elif what == "stretch":
-                    value, names = argument
-                    done = self.board.stretch(value, *[self.unprefixed(n) for n in names])
-                    message = f"stretch {value}: {len(done)} joints"
-                elif what == "adjust":
-                    message = self.adjust(argument)
-            except pyrcb4.Error as e:
-                ok, message = False, str(e) if str(e).startswith(what + ":") else f"{what}: {e}"
-                rospy.logerr("rcb4: %s", message)
-            if reply:
-                reply[1].update(ok=ok, message=message)
-                reply[0].set()
-
-    def read_freed(self):
-        """Which joints are free on the board now (target FREE): at start and after a reconnect the
-        node knows nothing else of them."""
-        try:
-            servos = self.board.servos()
-        except pyrcb4.Error as e:
-            rospy.logwarn("rcb4: the servos' states could not be read (%s): joints taken as held", e)
-            self.freed[:] = False
-            return
-        targets = {v["joint"]: v["target"] for v in servos.values()}
-        for i, n in enumerate(self.names):
-            self.freed[i] = targets.get(n) == 0x8000
-        if self.freed.any():
-            rospy.loginfo("rcb4: free on the board: %s", ", ".join(self.prefix + n for n, f in zip(self.names, self.freed) if f))
-
     def unprefixed(self, name):
         return name[len(self.prefix):] if self.prefix and name.startswith(self.prefix) else name
-
-    def reference(self, i, now):
-        """Where joint @p i is meant to be at @p now, as the board interpolates its move (NaN: unknown)."""
-        m = self.moves.get(i)
-        if m is None:
-            return math.nan
-        t0, a, b, t1 = m
-        return b if now >= t1 or t1 <= t0 else a + (b - a) * (now - t0) / (t1 - t0)
-
-    def adjust(self, thresholds):
-        """kxr_controller's AdjustAngleVector: a held joint further than its threshold (degrees) from
-        where it is meant to be now holds where it is."""
-        now = time.monotonic()
-        over = []
-        for name, limit in thresholds:
-            i = self.index[name]
-            error = abs(self.reference(i, now) - self.angles[i])
-            if not self.freed[i] and error > limit:  # NaN (no move known, not measured) is not over
-                over.append((i, error, limit))
-        if not over:
-            return "no joint is further from its reference than its threshold"
-        self.board.hold(*[self.names[i] for i, _, _ in over])
-        for i, _, _ in over:
-            self.moves.pop(i, None)
-        return "held " + ", ".join(f"{self.prefix + self.names[i]} ({e:.1f} deg > {lim:g})" for i, e, lim in over)
-
-    def drop(self, indices):
-        """Drops what is under way (trajectory, stream) for the joints at @p indices; their names."""
-        idx = list(indices)
-        with self.lock:
-            busy = set()
-            rest = []
-            for at, t, frames in self.trajectory:
-                t = t.copy()
-                busy.update(i for i in idx if not math.isnan(t[i]))
-                t[idx] = numpy.nan
-                if not numpy.isnan(t).all():
-                    rest.append((at, t, frames))
-            self.trajectory = rest
-            if self.stream is not None:
-                busy.update(i for i in idx if not math.isnan(self.stream[i]))
-                self.stream = self.stream.copy()
-                self.stream[idx] = numpy.nan
-                if numpy.isnan(self.stream).all():
-                    self.stream = None
-        return [self.prefix + self.names[i] for i in sorted(busy)]
-
-    def halt_now(self):
-        """Every joint that is held holds where it is now (HOLD: the board stops its interpolation there)."""
-        held = [n for n, f in zip(self.names, self.freed) if not f]
-        if held:
-            self.board.hold(*held)
-        self.moves.clear()
-
-    def without_freed(self, targets, what):
-        """@p targets with the freed joints left out (a position would power them again), said once."""
-        named = ~numpy.isnan(targets) & self.freed
-        if named.any():
-            self.refuse(f"{what}: {', '.join(self.prefix + self.names[i] for i in numpy.flatnonzero(named))} "
-                        f"{'is' if named.sum() == 1 else 'are'} free: left out (~hold or ~hold_joints first)")
-            targets = targets.copy()
-            targets[named] = numpy.nan
-        return targets
-
-    def write_due(self):
-        now = time.monotonic()
-        with self.lock:
-            halt, self.halt = self.halt, False
-        if halt:
-            self.halt_now()
-            return
-        with self.lock:
-            due = None
-            while self.trajectory and self.trajectory[0][0] <= now:
-                due = self.trajectory.pop(0)
-            stream, self.stream = self.stream, None
-        motion = self.last_motion or {}
-        # The one rule for a move during a ROM motion (rcb4/robot/services/moves.hpp, through pyrcb4).
-        refusal = pyrcb4.move_refusal(motion) if (due or stream is not None) else None
-        if refusal:
-            self.refuse(f"{refusal} (~stop_motion first)")
-            with self.lock:
-                self.trajectory = []
-                self.generation += 1
-                self.replaced_by = f"{refusal} (~stop_motion first)"
-            return
-        if due:
-            due = (due[0], self.without_freed(due[1], "trajectory"), due[2])
-            if numpy.isnan(due[1]).all():
-                due = None
-        if stream is not None:
-            stream = self.without_freed(stream, "joint_command")
-            if numpy.isnan(stream).all():
-                stream = None
-        if due:
-            # Points due in the same cycle (denser than the rate, or a late cycle): the last one, over
-            # what is left of its time, so the joints do not hurry and then wait.
-            at, targets, frames = due
-            if frames > 0:
-                frames = max(1, round((at + frames * self.period - now) / self.period))
-            self.write(targets, frames, now)
-        elif stream is not None:
-            self.write(stream, max(1, round(1.0 / self.rate / self.period)), now)
-
-    def write(self, targets, frames, now):
-        """Sends a move; one the board refuses (a joint with no servo on it) is dropped and said, with
-        what was under way: it is not the link failing."""
-        try:
-            self.loop.write(targets, frames=frames)
-        except pyrcb4.BoardRefused as e:
-            with self.lock:
-                self.trajectory, self.stream = [], None
-                self.generation += 1
-                self.replaced_by = f"dropped: {e}"
-            self.refuse(f"a command was dropped: {e}")
-            return
-        self.moved(targets, frames, now)
-
-    def moved(self, targets, frames, now):
-        """Keeps the moves just sent (for AdjustAngleVector's reference)."""
-        for i in numpy.flatnonzero(~numpy.isnan(targets)):
-            i = int(i)
-            start = self.reference(i, now)
-            if math.isnan(start):
-                start = self.angles[i]
-            self.moves[i] = (now, start, float(targets[i]), now + frames * self.period)
 
     def cycle(self):
         self.carry_out()
@@ -595,20 +270,6 @@ class Rcb4Node:
                 self.actions.wait_idle(1.0)
             if not self.released:
                 self.board.close()
-
-    def drop_requests(self, why):
-        """What was asked while the board does not answer is dropped, answered and logged: it must not
-        run later, when a board answers again."""
-        while True:
-            try:
-                what, _, reply = self.requests.get_nowait()
-            except queue.Empty:
-                return
-            rospy.logwarn("rcb4: %s: dropped, the board does not answer (%s)", what, why)
-            if reply:
-                reply[1].update(ok=False, message=f"{what}: the board does not answer ({why}): nothing was done")
-                reply[0].set()
-
 
 def main():
     # The node's own signal handling: the loop ends at once and lets the board go, then rospy shuts
