@@ -92,13 +92,28 @@ with ics_serve() as pty:
     rc, _, err = run("--device", pty, "--trace", "ics", "temperature")
     check(rc == 0 and "->" in err and "A5 04" in err and "<-" in err and "25 04" in err,
           f"--trace shows the exchanges ({err.strip()[:200]})")
-    # damaged backups: a field beyond its range, an unknown baud code
+    # byte 16's fixed bit 2 and FREE status bit 1 are never written from a file
     good = open("a.bin", "rb").read()
+    with open("bits.bin", "wb") as f:
+        f.write(good[:15] + bytes([good[15] | 0x6]) + good[16:])
+    rc, out, err = ics(pty, "eeprom", "restore", "bits.bin")
+    check(rc == 0 and "nothing to change" in out and raw(pty) == before,
+          f"restore of a file with byte 16's bits 1 and 2 set writes neither ({out.strip()} {err.strip()})")
+    rc, out, err = ics(pty, "eeprom", "show", "a.bin")
+    check(rc == 0 and "a.bin: EEPROM backup" in out and "stretch            60" in out,
+          f"eeprom show FILE decodes a backup ({err.strip()})")
+    rc, out, err = ics(pty, "set", "stretch=41", "--dry-run", json_out=True)
+    check(rc == 0 and json.loads(out)["dry_run"] and json.loads(out)["changed"] == {"stretch": 41}
+          and raw(pty) == before, f"set --dry-run shows the change, writes nothing ({out.strip()})")
+    # damaged backups: a field beyond its range, an unknown baud code
     with open("stretch0.bin", "wb") as f:
         f.write(good[:2] + bytes([0, 0]) + good[4:])
     with open("baud5.bin", "wb") as f:
         f.write(good[:27] + bytes([5]) + good[28:])
-    for name, words in (("stretch0.bin", "stretch is 0, beyond 1..127"), ("baud5.bin", "baud code is 5")):
+    with open("odd.bin", "wb") as f:
+        f.write(good[:2] + bytes([5, 1]) + good[4:])
+    for name, words in (("stretch0.bin", "stretch is 0, beyond 1..127"), ("baud5.bin", "baud code is 5"),
+                        ("odd.bin", "stored odd")):
         rc, _, err = ics(pty, "eeprom", "restore", name)
         check(rc == 2 and words in err and raw(pty) == before, f"restore {name}: exit 2, nothing written ({err.strip()})")
 
@@ -117,6 +132,24 @@ with ics_serve() as pty:
     check(rc == 0 and "amperes" in json.loads(out), f"current reads ({out.strip()})")
     rc, out, _ = ics(pty, "stretch", "50", json_out=True)
     check(rc == 0 and json.loads(out)["stretch"] == 50, "stretch 50 set live")
+    # a slow servo: --wait gives up at --max-wait, says it is still moving, one JSON object
+    check(ics(pty, "speed", "3")[0] == 0, "speed 3 set live")
+    rc, out, err = ics(pty, "position", "-130", "--wait", "--max-wait", "0.3", json_out=True)
+    one = json.loads(out) if rc == 1 and out.count("\n") == 1 else {}
+    check(rc == 1 and one.get("arrived") is False and "still moving" in one.get("error", ""),
+          f"--wait --max-wait 0.3 on a slow servo: exit 1, one JSON object ({out.strip()} {err.strip()})")
+    # Ctrl-C ends a wait at its next read: exit 130, said, promptly
+    import signal
+    import time
+    p = subprocess.Popen([RCB4, "--device", pty, "ics", "position", "130", "--wait", "--max-wait", "30"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    time.sleep(0.5)
+    p.send_signal(signal.SIGINT)
+    t0 = time.monotonic()
+    out, err = p.communicate(timeout=10)
+    check(p.returncode == 130 and "interrupted" in err and time.monotonic() - t0 < 2,
+          f"Ctrl-C during position --wait: exit 130 at once ({p.returncode}: {err.strip()})")
+    check(ics(pty, "speed", "127")[0] == 0, "speed 127 again")
 
     # refusals: nothing written
     now = raw(pty)
@@ -125,7 +158,8 @@ with ics_serve() as pty:
         (("set", "stretch=200"), 2, "out of range"),
         (("set", "baud=9600"), 2, "115200, 625000 or 1250000"),
         (("set", "id=3"), 2, "ics id set"),
-        (("set", "nonsense=1"), 2, "expected FIELD=VALUE"),
+        (("set", "nonsense=1"), 2, "no EEPROM field is called 'nonsense'"),
+        (("set", "stretch"), 2, "expected FIELD=VALUE"),
         (("set", "reverse=maybe"), 2, "give on or off"),
         (("set", "slave=on"), 2, "never answer again"),
         (("set", "stretch=40", "stretch=41"), 2, "given twice"),
@@ -159,6 +193,10 @@ with ics_serve("--seed", "7") as pty:
 with ics_serve("--servos", "2") as pty:
     rc, out, _ = ics(pty, "scan", json_out=True)
     check(rc == 0 and [s["id"] for s in json.loads(out)["servos"]] == [0, 1], f"scan finds both ({out.strip()})")
+    rc, out, _ = ics(pty, "--id", "1", "scan", json_out=True)
+    check(rc == 0 and [s["id"] for s in json.loads(out)["servos"]] == [1], f"scan --id 1 asks ID 1 only ({out.strip()})")
+    rc, _, err = ics(pty, "id")
+    check(rc == 1 and "leave one servo alone" in err, f"id with two servos: the hint is about ID work ({err.strip()})")
     before0 = ics(pty, "--id", "0", "eeprom", "show", json_out=True)[1]
     rc, out, err = ics(pty, "id", "set", "5")
     check(rc == 1 and "more than one device" in err, f"id set with two servos: exit 1 ({err.strip()})")
@@ -200,13 +238,19 @@ with ics_serve("--servo-baud", "1250000", "--ics35", "--servo-id", "3") as pty:
 # slave=on with --force: written, and the servo never answers again
 with ics_serve("--servo-id", "2") as pty:
     rc, out, err = ics(pty, "set", "slave=on", "--force")
-    check(rc == 0 and "slave now" in out, f"set slave=on --force writes it, says so ({out.strip()} {err.strip()})")
+    check(rc == 0 and "slave now" in out and "not read back" in out,
+          f"set slave=on --force writes it, says it was not read back ({out.strip()} {err.strip()})")
     rc, _, err = ics(pty, "id")
     check(rc == 4, f"then the servo never answers ({err.strip()})")
 
 rc, out, err = run("--device", "/dev/nonexistent-ics", "ics", "id")
 check(rc == 3, f"a missing device: exit 3 ({err.strip()})")
-rc, out, _ = run("--json", "ics", "eeprom", "show")
-check(rc == 0 and json.loads(out)["stretch"] == 60, "without --device: the in-process virtual servo")
+rc, out, err = run("--json", "ics", "eeprom", "show")
+check(rc == 0 and json.loads(out)["stretch"] == 60 and "virtual servo" in err,
+      f"without --device: the in-process virtual servo, and it says so ({err.strip()})")
+rc, _, err = run("--device", "tcp:127.0.0.1:9", "ics", "id")
+check(rc == 2 and "not TCP" in err, f"a tcp: device is refused for ICS ({err.strip()})")
+rc, _, err = run("ics", "eeprom", "restore", "/tmp")
+check(rc == 2 and "not a file" in err, f"restore of a directory: exit 2 ({err.strip()})")
 
 finish()

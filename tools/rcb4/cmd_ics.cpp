@@ -5,9 +5,10 @@
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
 
+#include "cmd_ics_line.hpp"
+
 #include <rcb4/ics/virtual_servo.hpp>
 #include <rcb4/robot/services/ics.hpp>
-#include <rcb4/transport/ics_port.hpp>
 
 #include <cmath>
 #include <thread>
@@ -18,6 +19,9 @@ namespace {
 namespace sv = rcb4::robot::services;
 namespace ics = rcb4::ics;
 using namespace std::chrono_literals;
+using ics_line::guarded;
+using ics_line::line;
+using ics_line::options_of;
 
 /** What `rcb4 ics` takes before its command. */
 struct ics_globals {
@@ -26,85 +30,17 @@ struct ics_globals {
   std::string backup_dir = ".";  ///< where set and restore save the old image
 };
 
-/** The line: the port --device names, or an in-process virtual servo. */
-class line {
- public:
-  explicit line(const globals& g) : trace_(g.trace) {
-    if (!g.empty_device.empty())
-      throw failure(exit_usage, "--device is empty: name the adapter's port, or leave it out for a virtual servo");
-    const auto baud = g.baud.value_or(115200);
-    if (g.device.empty()) {
-      virtual_ = std::make_unique<sv::ics_virtual_link>(ics::virtual_line({ics::virtual_servo{}}));
-      virtual_->set_baud(baud);
-      return;
-    }
-    try {
-      port_ = std::make_unique<rcb4::transport::ics_port>(g.device, baud);
-    } catch (const boost::system::system_error& e) {
-      throw explain(std::error_code(e.code()), fmt::format("cannot open {}: {}", g.device, e.code().message()));
-    }
-    link_ = std::make_unique<sv::ics_port_link<rcb4::transport::ics_port>>(*port_);
-  }
-  sv::ics_link& get() {
-    sv::ics_link& inner = virtual_ ? static_cast<sv::ics_link&>(*virtual_) : *link_;
-    if (!trace_) return inner;
-    if (!traced_) traced_ = std::make_unique<tracer>(inner);
-    return *traced_;
-  }
-
- private:
-  /** --trace: every exchange on stderr, time, rate, bytes out and in. */
-  class tracer final : public sv::ics_link {
-   public:
-    explicit tracer(sv::ics_link& inner) : in_(inner), start_(std::chrono::steady_clock::now()) {}
-    std::vector<std::uint8_t> transact(std::span<const std::uint8_t> request, std::size_t expect,
-                                       std::chrono::milliseconds wait) override {
-      print("->", request);
-      auto rx = in_.transact(request, expect, wait);
-      print(rx.size() < expect ? "<- (short)" : "<-", rx);
-      return rx;
-    }
-    std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) override {
-      auto rx = in_.linger(wait);
-      if (!rx.empty()) print("<- (late)", rx);
-      return rx;
-    }
-    void set_baud(std::uint32_t baud) override { in_.set_baud(baud); }
-    std::uint32_t baud() const override { return in_.baud(); }
-
-   private:
-    void print(std::string_view dir, std::span<const std::uint8_t> b) const {
-      std::string hex;
-      for (auto x : b) hex += fmt::format(" {:02X}", x);
-      fmt::print(stderr, "{:10.3f} ms  {:>7}  {:<10}{}\n",
-                 std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_).count(),
-                 in_.baud(), dir, hex);
-    }
-    sv::ics_link& in_;
-    std::chrono::steady_clock::time_point start_;
-  };
-  bool trace_ = false;
-  std::unique_ptr<tracer> traced_;
-  std::unique_ptr<sv::ics_virtual_link> virtual_;
-  std::unique_ptr<rcb4::transport::ics_port> port_;
-  std::unique_ptr<sv::ics_link> link_;
-};
-
-sv::ics_options options_of(const globals& g) {
-  sv::ics_options o;
-  o.timeout = g.timeout;
-  return o;
-}
-
 /** Runs @p f on the servo --id names (or the one on the line), found at --baud or each rate. */
-void on_servo(CLI::App* cmd, context& ctx, const std::shared_ptr<ics_globals>& ig,
-              std::function<int(sv::ics_servo&)> f) {
-  on_run(cmd, ctx, [&ctx, ig, f] {
-    line l(ctx.g);
-    std::optional<ics::servo_id> id;
-    if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
-    sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g));
-    return f(s);
+void on_servo(CLI::App* cmd, context& ctx, const std::shared_ptr<ics_globals>& ig, std::function<int(sv::ics_servo&)> f,
+              bool id_work = false) {
+  on_run(cmd, ctx, [&ctx, ig, f, id_work] {
+    return guarded([&] {
+      line l(ctx.g);
+      std::optional<ics::servo_id> id;
+      if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
+      sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g), id_work);
+      return f(s);
+    });
   });
 }
 
@@ -130,31 +66,38 @@ double icssw_celsius(int v) {
   return std::round(y0 + (v - x0) * (y1 - y0) / (x1 - x0));
 }
 
-int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_view what) {
+int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_view what, bool dry_run) {
   if (g.json) {
     json changed = json::object();
     for (const auto& [f, v] : r.changed)
       changed[std::string(ics::info(f).name)] = ics::info(f).nibbles == 0 ? json(v != 0) : json(v);
     emit(json{{"written", r.written},
+              {"verified", r.verified},
+              {"dry_run", dry_run},
               {"changed", changed},
               {"backup", r.backup.empty() ? json(nullptr) : json(r.backup)},
               {"notes", r.notes}});
     return exit_ok;
   }
-  if (!r.written) {
+  if (!r.written && (!dry_run || r.after == r.before)) {
     fmt::print("nothing to change: the EEPROM already holds {}\n", what);
     for (const auto& n : r.notes) fmt::print("note: {}\n", n);
     return exit_ok;
   }
   for (const auto& [f, v] : r.changed)
     fmt::print("{:<18} {} -> {}\n", ics::info(f).name, value_text(f, r.before.get(f)), value_text(f, v));
-  fmt::print("written and read back (64 bytes equal); the old image is in {}\n", r.backup);
+  if (dry_run)
+    fmt::print("a dry run: nothing was written\n");
+  else if (r.verified)
+    fmt::print("written and read back (64 bytes equal); the old image is in {}\n", r.backup);
+  else
+    fmt::print("written, not read back (a slave never answers); the old image is in {}\n", r.backup);
   for (const auto& n : r.notes) fmt::print("note: {}\n", n);
   return exit_ok;
 }
 
-int eeprom_show(sv::ics_servo& s, const globals& g) {
-  const auto e = s.read_eeprom();
+/** Every field of @p e, under @p title (text) or as one JSON object. */
+int show_image(const ics::eeprom_image& e, const std::string& title, const globals& g) {
   std::string raw;
   for (auto b : e.bytes()) raw += fmt::format("{}{:02X}", raw.empty() ? "" : " ", b);
   if (g.json) {
@@ -165,7 +108,7 @@ int eeprom_show(sv::ics_servo& s, const globals& g) {
     emit(j);
     return exit_ok;
   }
-  fmt::print("ICS servo {} at {} baud: EEPROM\n", s.id().value(), s.baud());
+  fmt::print("{}\n", title);
   for (const auto& i : ics::fields) fmt::print("  {:<18} {:<22} {}\n", i.name, value_text(i.f, e.get(i.f)), i.what);
   fmt::print("  raw {}\n", raw);
   return exit_ok;
@@ -186,7 +129,8 @@ std::uint16_t target_of(const std::string& word) {
   throw usage_error(fmt::format("position {}: give degrees (-135..135) or counts (3500..11500)", word));
 }
 
-int position(sv::ics_servo& s, const std::string& word, bool wait, const globals& g) {
+int position(sv::ics_servo& s, const std::string& word, bool wait, std::chrono::milliseconds max_wait,
+             const globals& g) {
   json j{{"id", s.id().value()}};
   if (word.empty()) {
     const auto p = s.position();
@@ -212,37 +156,47 @@ int position(sv::ics_servo& s, const std::string& word, bool wait, const globals
   const auto was = s.move(target);
   j["target"] = position_json(target);
   j["was"] = position_json(was);
-  std::uint16_t now = was;
-  bool there = true;
-  if (wait) {  // read every 20 ms until there (3 counts, 0.1 degree), 5 s at most, or no closer for 0.5 s
-    const auto start = std::chrono::steady_clock::now();
-    auto closer_at = start;
-    int best = std::abs(was - target);
-    for (;;) {
-      now = s.position();
-      const int off = std::abs(now - target);
-      const auto t = std::chrono::steady_clock::now();
-      if (off < best) best = off, closer_at = t;
-      if (off <= 3 || t - start > 5s || t - closer_at > 500ms) break;
-      std::this_thread::sleep_for(20ms);  // the servo's pace: a read every 20 ms is enough
-    }
-    there = std::abs(now - target) <= ics::position::counts_per_degree;
-    j.update(position_json(now));
-    j["arrived"] = there;
-  }
-  if (g.json)
-    emit(j);
-  else {
+  if (!g.json)
     fmt::print("ICS servo {} to {} ({:+.2f} deg); it stood at {} ({:+.2f} deg)\n", s.id().value(), target, deg(target),
                was, deg(was));
-    if (wait) fmt::print("now at {} ({:+.2f} deg)\n", now, deg(now));
+  if (!wait) {
+    if (g.json) emit(j);
+    return exit_ok;
   }
-  if (!there)
-    throw failure(exit_board,
-                  fmt::format("ICS servo {} stopped {:.1f} deg short of the target", s.id().value(),
-                              std::abs(deg(now) - deg(target))),
-                  "a load or an obstacle, its limits (rcb4 ics eeprom show: min_limit, max_limit) or a low speed");
-  return exit_ok;
+  // Read every 20 ms until there (3 counts, 0.1 degree), no closer for 0.5 s, max_wait, or Ctrl-C.
+  std::uint16_t now = was;
+  const auto start = std::chrono::steady_clock::now();
+  auto closer_at = start;
+  int best = std::abs(was - target);
+  bool timed_out = false;
+  for (;;) {
+    now = s.position();
+    const int off = std::abs(now - target);
+    const auto t = std::chrono::steady_clock::now();
+    if (off < best) best = off, closer_at = t;
+    timed_out = t - start > max_wait;
+    if (off <= 3 || timed_out || t - closer_at > 500ms || signal_catcher::caught()) break;
+    std::this_thread::sleep_for(20ms);  // the servo's pace: a read every 20 ms is enough
+  }
+  const bool there = std::abs(now - target) <= ics::position::counts_per_degree;
+  j.update(position_json(now));
+  j["arrived"] = there;
+  if (!g.json) fmt::print("now at {} ({:+.2f} deg)\n", now, deg(now));
+  if (there || signal_catcher::caught()) {
+    if (g.json) emit(j);
+    return exit_ok;
+  }
+  const double short_by = std::abs(deg(now) - deg(target));
+  throw failure(exit_board,
+                timed_out
+                    ? fmt::format("ICS servo {} is still {:.1f} deg from the target after {} s (still moving: "
+                                  "a low speed?)",
+                                  s.id().value(), short_by, std::chrono::duration<double>(max_wait).count())
+                    : fmt::format("ICS servo {} stopped {:.1f} deg short of the target", s.id().value(), short_by),
+                timed_out ? "--max-wait S waits longer"
+                          : "a load or an obstacle, its limits (rcb4 ics eeprom show: min_limit, max_limit) or a low "
+                            "speed",
+                g.json ? j : json());
 }
 
 int parameter(sv::ics_servo& s, ics::sub what, const char* name, const std::string& value, const globals& g) {
@@ -262,8 +216,24 @@ int parameter(sv::ics_servo& s, ics::sub what, const char* name, const std::stri
 void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<ics_globals>& ig) {
   auto* eeprom = ics_cmd->add_subcommand("eeprom", "the servo's 64-byte EEPROM: show, backup FILE, restore FILE");
   eeprom->require_subcommand(1);
-  on_servo(eeprom->add_subcommand("show", "every field, decoded (units of ICS Manager: stretch 1-127)"), ctx, ig,
-           [&ctx](sv::ics_servo& s) { return eeprom_show(s, ctx.g); });
+  auto shown = std::make_shared<std::string>();
+  auto* show = eeprom->add_subcommand(
+      "show", "every field, decoded (units of ICS Manager: stretch 1-127); with FILE: a backup, no servo needed");
+  show->add_option("FILE", *shown, "a backup from `ics eeprom backup` (none: the servo's EEPROM)");
+  show->callback([&ctx, ig, shown] {
+    ctx.action = [&ctx, ig, shown] {
+      if (!shown->empty())
+        return show_image(sv::load_ics_image(*shown), fmt::format("{}: EEPROM backup", *shown), ctx.g);
+      return guarded([&] {
+        line l(ctx.g);
+        std::optional<ics::servo_id> id;
+        if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
+        sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g));
+        return show_image(s.read_eeprom(), fmt::format("ICS servo {} at {} baud: EEPROM", s.id().value(), s.baud()),
+                          ctx.g);
+      });
+    };
+  });
 
   auto file = std::make_shared<std::string>();
   auto* backup = eeprom->add_subcommand("backup", "save the servo's own 64 bytes to FILE");
@@ -286,10 +256,13 @@ void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<
       eeprom->add_subcommand("restore", "write a backup back (this servo's own; its factory bytes are never written)");
   restore->add_option("FILE", *rfile, "a file from `ics eeprom backup`")->required();
   restore->add_flag("--force", *force,
-                    "write another servo's settings (this servo's factory bytes are kept), or a slave flag");
-  on_servo(restore, ctx, ig, [&ctx, ig, rfile, force](sv::ics_servo& s) {
+                    "write another servo's settings (this servo's factory bytes and user_offset are kept), or a "
+                    "slave flag");
+  auto dry = std::make_shared<bool>(false);
+  restore->add_flag("--dry-run", *dry, "show what would change, write nothing");
+  on_servo(restore, ctx, ig, [&ctx, ig, rfile, force, dry](sv::ics_servo& s) {
     const auto image = sv::load_ics_image(*rfile);
-    return print_report(s.restore(image, *force, sv::ics_backup_in(ig->backup_dir, s.id())), ctx.g, *rfile);
+    return print_report(s.restore(image, *force, sv::ics_backup_in(ig->backup_dir, s.id()), *dry), ctx.g, *rfile, *dry);
   });
 }
 
@@ -313,73 +286,88 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   scan->add_option("--scan-timeout", ig->scan_timeout, "ms to wait for each ID (default 30)")
       ->check(int_range(1, 10000));
   on_run(scan, ctx, [&ctx, ig] {
-    line l(ctx.g);
-    auto o = options_of(ctx.g);
-    o.timeout = std::chrono::milliseconds(ig->scan_timeout);
-    std::vector<std::uint32_t> bs;
-    if (ctx.g.baud) bs.push_back(*ctx.g.baud);
-    const auto found = sv::ics_scan(l.get(), bs, o, [&ctx](std::uint32_t b) {
-      if (!ctx.g.json) fmt::print(stderr, "scanning IDs 0-31 at {} baud\n", b);
-    });
-    json servos = json::array();
-    json bad = json::array();
-    bool any = false;
-    for (const auto& f : found) {
-      if (!f.problem.empty()) {
-        bad.push_back(json{{"id", f.id.value()}, {"baud", f.baud}, {"problem", f.problem}});
-        continue;
+    return guarded([&] {
+      line l(ctx.g);
+      auto o = options_of(ctx.g);
+      o.timeout = std::chrono::milliseconds(ig->scan_timeout);
+      o.interrupted = [] { return signal_catcher::caught(); };
+      std::vector<std::uint32_t> bs;
+      if (ctx.g.baud) bs.push_back(*ctx.g.baud);
+      std::optional<ics::servo_id> only;
+      if (ig->id >= 0) only = ics::servo_id::make(ig->id).value();
+      const auto found = sv::ics_scan(
+          l.get(), bs, o,
+          [&ctx, only](std::uint32_t b) {
+            if (!ctx.g.json)
+              fmt::print(stderr, "scanning {} at {} baud\n", only ? fmt::format("ID {}", only->value()) : "IDs 0-31",
+                         b);
+          },
+          only);
+      json servos = json::array();
+      json bad = json::array();
+      bool any = false;
+      for (const auto& f : found) {
+        if (!f.problem.empty()) {
+          bad.push_back(json{{"id", f.id.value()}, {"baud", f.baud}, {"problem", f.problem}});
+          continue;
+        }
+        any = true;
+        servos.push_back(json{{"id", f.id.value()},
+                              {"baud", f.baud},
+                              {"ics", f.ics36 ? "3.6" : "3.5"},
+                              {"stretch", f.stretch},
+                              {"speed", f.speed}});
       }
-      any = true;
-      servos.push_back(json{{"id", f.id.value()},
-                            {"baud", f.baud},
-                            {"ics", f.ics36 ? "3.6" : "3.5"},
-                            {"stretch", f.stretch},
-                            {"speed", f.speed}});
-    }
-    if (ctx.g.json)
-      emit(json{{"servos", servos}, {"garbled", bad}});
-    else if (found.empty())
-      fmt::print("no ICS servo answered\n");
-    for (const auto& f : found)
-      if (ctx.g.json) {
-      } else if (f.problem.empty())
-        fmt::print("ID {:2}  {:>7} baud  ICS {}  stretch {}  speed {}\n", f.id.value(), f.baud,
-                   f.ics36 ? "3.6" : "3.5 (no SC 5 position read)", f.stretch, f.speed);
-      else
-        fmt::print("ID {:2}  {:>7} baud  answers wrongly: {}\n", f.id.value(), f.baud, f.problem);
-    return any ? exit_ok : found.empty() ? exit_timeout : exit_board;
+      if (ctx.g.json)
+        emit(json{{"servos", servos}, {"garbled", bad}});
+      else if (found.empty())
+        fmt::print("no ICS servo answered\n");
+      for (const auto& f : found)
+        if (ctx.g.json) {
+        } else if (f.problem.empty())
+          fmt::print("ID {:2}  {:>7} baud  ICS {}  stretch {}  speed {}\n", f.id.value(), f.baud,
+                     f.ics36 ? "3.6" : "3.5 (no SC 5 position read)", f.stretch, f.speed);
+        else
+          fmt::print("ID {:2}  {:>7} baud  answers wrongly: {}\n", f.id.value(), f.baud, f.problem);
+      return any ? exit_ok : found.empty() ? exit_timeout : exit_board;
+    });
   });
 
   auto new_id = std::make_shared<long long>(-1);
   auto* id = cmd->add_subcommand("id", "the ID of the one servo on the line; `id set N` gives it a new one");
   auto* id_set = id->add_subcommand("set", "give the servo alone on the line ID N (checked alone first, read back)");
   id_set->add_option("N", *new_id, "0-31")->required()->check(int_range(0, 31));
-  on_servo(id_set, ctx, ig, [&ctx, new_id](sv::ics_servo& s) {
-    const auto was = s.id();
-    const auto n = s.set_id(ics::servo_id::make(*new_id).value());
-    if (ctx.g.json)
-      emit(json{{"id", n.value()}, {"was", was.value()}, {"written", was != n}});
-    else if (was == n)
-      fmt::print("the servo is ID {} already: nothing written\n", n.value());
-    else
-      fmt::print("ID {} -> {} (read back)\n", was.value(), n.value());
-    return exit_ok;
-  });
+  on_servo(
+      id_set, ctx, ig,
+      [&ctx, new_id](sv::ics_servo& s) {
+        const auto was = s.id();
+        const auto n = s.set_id(ics::servo_id::make(*new_id).value());
+        if (ctx.g.json)
+          emit(json{{"id", n.value()}, {"was", was.value()}, {"written", was != n}});
+        else if (was == n)
+          fmt::print("the servo is ID {} already: nothing written\n", n.value());
+        else
+          fmt::print("ID {} -> {} (read back)\n", was.value(), n.value());
+        return exit_ok;
+      },
+      true);
 
   // `id` alone reads; its callback runs after `id set`'s, so it leaves set's action alone.
   id->callback([&ctx, ig, id_set] {
     if (id_set->parsed()) return;
     ctx.action = [&ctx, ig] {
-      line l(ctx.g);
-      std::optional<ics::servo_id> want;
-      if (ig->id >= 0) want = ics::servo_id::make(ig->id).value();
-      sv::ics_servo s(l.get(), want, ctx.g.baud, options_of(ctx.g));
-      const auto n = s.read_id();
-      if (ctx.g.json)
-        emit(json{{"id", n.value()}, {"baud", s.baud()}});
-      else
-        fmt::print("{}\n", n.value());
-      return exit_ok;
+      return guarded([&] {
+        line l(ctx.g);
+        std::optional<ics::servo_id> want;
+        if (ig->id >= 0) want = ics::servo_id::make(ig->id).value();
+        sv::ics_servo s(l.get(), want, ctx.g.baud, options_of(ctx.g), true);
+        const auto n = s.read_id();
+        if (ctx.g.json)
+          emit(json{{"id", n.value()}, {"baud", s.baud()}});
+        else
+          fmt::print("{}\n", n.value());
+        return exit_ok;
+      });
     };
   });
   add_eeprom_commands(cmd, ctx, ig);
@@ -389,26 +377,36 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   auto* set = cmd->add_subcommand("set", "change EEPROM fields: read, modify, back up, write, read back");
   set->add_option("FIELD=VALUE", *settings, "e.g. stretch=40 speed=100 reverse=on baud=625000")->required();
   set->add_flag("--force", *set_force, "write a setting that stops the servo answering (slave=on)");
+  auto set_dry = std::make_shared<bool>(false);
+  set->add_flag("--dry-run", *set_dry, "show what would change, write nothing");
   set->footer(
       "fields: stretch speed punch dead_band damping safe_timer slave rotation pwm_inhibit reverse max_limit "
       "min_limit baud temperature_limit current_limit response user_offset stretch_1 stretch_2 stretch_3");
-  on_run(set, ctx, [&ctx, ig, settings, set_force] {
+  on_run(set, ctx, [&ctx, ig, settings, set_force, set_dry] {
     std::vector<std::pair<ics::field, long>> changes;
     for (const auto& w : *settings) changes.push_back(sv::parse_ics_setting(w));  // before the line opens
-    line l(ctx.g);
-    std::optional<ics::servo_id> sid;
-    if (ig->id >= 0) sid = ics::servo_id::make(ig->id).value();
-    sv::ics_servo s(l.get(), sid, ctx.g.baud, options_of(ctx.g));
-    return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id()), *set_force), ctx.g,
-                        join(*settings));
+    return guarded([&] {
+      line l(ctx.g);
+      std::optional<ics::servo_id> sid;
+      if (ig->id >= 0) sid = ics::servo_id::make(ig->id).value();
+      sv::ics_servo s(l.get(), sid, ctx.g.baud, options_of(ctx.g));
+      return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id()), *set_force, *set_dry), ctx.g,
+                          join(*settings), *set_dry);
+    });
   });
 
   auto where = std::make_shared<std::string>();
   auto wait = std::make_shared<bool>(false);
   auto* pos = cmd->add_subcommand("position", "where it stands (ICS 3.6), or move it: DEG, COUNTS or free");
   pos->add_option("TARGET", *where, "degrees (-135..135), counts (3500..11500) or free");
-  pos->add_flag("--wait", *wait, "after a move: read until it is there or stops getting closer, 5 s at most (ICS 3.6)");
-  on_servo(pos, ctx, ig, [&ctx, where, wait](sv::ics_servo& s) { return position(s, *where, *wait, ctx.g); });
+  pos->add_flag("--wait", *wait, "after a move: read until it is there or stops getting closer (ICS 3.6)");
+  auto max_wait = std::make_shared<double>(5.0);
+  pos->add_option("--max-wait", *max_wait, "with --wait: give up after S seconds (default 5)")
+      ->type_name("S")
+      ->check(CLI::Range(0.1, 600.0));
+  on_servo(pos, ctx, ig, [&ctx, where, wait, max_wait](sv::ics_servo& s) {
+    return position(s, *where, *wait, std::chrono::milliseconds(static_cast<long long>(*max_wait * 1000)), ctx.g);
+  });
 
   for (auto [name, what, help] : {std::tuple{"stretch", ics::sub::stretch, "stiffness 1-127: read, or set live"},
                                   {"speed", ics::sub::speed, "speed 1-127: read, or set live"}}) {

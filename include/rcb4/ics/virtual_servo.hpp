@@ -8,6 +8,7 @@
 //    set by speed (model: 600°/s at 127), current while it moves, a temperature on ICSSW's scale.
 //    ID 0 at 115200 answers a position with header 0x80 (ics.md §2.1). A 3.5 servo ignores SC 5.
 //    An EEPROM image it could not run with (ID past 31, unknown baud code) is ignored (model).
+//    It stops at its EEPROM limits (model).
 //  - virtual_line: the wire: every byte comes back (the echo, ics.md §1), then the replies of every
 //    servo that understood the frame, one after another (all of them for an ID command). A servo
 //    at another rate than the line's understands nothing. Misbehaviours for tests: silent, replies
@@ -113,7 +114,10 @@ class virtual_servo {
       put({static_cast<std::uint8_t>(compat ? 0x80 : me), position::high(now), position::low(now)});
       from_ = now, from_t_ = t;
       free_ = p->target() == position::free;
-      target_ = free_ ? now : p->target();
+      // model: it stops at its EEPROM limits
+      target_ = free_ ? now
+                      : std::clamp<double>(p->target(), static_cast<double>(image_.get(field::min_limit)),
+                                           static_cast<double>(image_.get(field::max_limit)));
     } else if (auto r = read_parameter::parse(f)) {
       put({static_cast<std::uint8_t>(0x20 | me), static_cast<std::uint8_t>(r->what()), parameter(r->what(), t)});
     } else if (auto w2 = write_parameter::parse(f)) {

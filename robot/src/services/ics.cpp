@@ -64,7 +64,10 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
   const std::size_t expect = req.size + Cmd::reply_size;
   std::string last;
   bool answered = false;
-  for (int attempt = 0; attempt < std::max(1, o_.tries); ++attempt) {
+  // A write waits long for its answer (seconds): tried twice at most, not three times.
+  const bool slow = wait > o_.timeout;
+  const int tries = std::max(1, slow ? std::min(o_.tries, 2) : o_.tries);
+  for (int attempt = 0; attempt < tries; ++attempt) {
     const auto rx = l_.transact(req.view(), expect, wait_for(expect, l_.baud(), wait));
     const auto p = ics::parse_exchange(c, rx);
     if (p.ok() && rx.size() == p.consumed) return p.value;
@@ -80,7 +83,7 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
                          hex(rx));
       answered = true;
     }
-    l_.linger(wait);  // let a late reply pass before the next frame (ics.md §1)
+    l_.linger(std::min(wait, o_.timeout));  // let a late reply pass before the next frame (ics.md §1)
   }
   const auto who = fmt::format("ICS servo {} at {} baud", id_.value(), l_.baud());
   if (!answered)
@@ -92,7 +95,8 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
                 "one servo alone on the adapter, its own supply; a corrupt or garbled reply is never used");
 }
 
-ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional<std::uint32_t> baud, ics_options o)
+ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional<std::uint32_t> baud, ics_options o,
+                     bool for_id_work)
     : l_(l), o_(o) {
   if (baud && !ics::baud_code(*baud))
     throw refused(refusal_kind::usage, fmt::format("--baud {}: an ICS line runs at 115200, 625000 or 1250000", *baud));
@@ -124,7 +128,7 @@ ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional
       (void)l_.linger(o_.timeout);
       continue;
     }
-    id_ = read_id(false);  // the full check: one clean answer, nothing after it
+    id_ = read_id(for_id_work);  // the full check: one clean answer, nothing after it
     return;
   }
   throw refused(refusal_kind::timeout,
@@ -141,7 +145,8 @@ ics::servo_id ics_servo::read_id(bool for_id_write) {
     rx = l_.transact(req.view(), req.size + 1, wait_for(req.size + 1, l_.baud(), o_.timeout));
     if (rx.size() > req.size) break;
   }
-  const auto extra = l_.linger(std::max(5ms, o_.timeout / 4));  // a second device answers late or garbled
+  // A second device answers late or garbled: within the first one's turnaround (an adapter's latency timer).
+  const auto extra = l_.linger(std::clamp(o_.timeout / 4, std::chrono::milliseconds(5), std::chrono::milliseconds(50)));
   rx.insert(rx.end(), extra.begin(), extra.end());
   const auto p = ics::parse_exchange(c, rx);
   const auto where = fmt::format("the ID read (FF 00 00 00) at {} baud", l_.baud());
@@ -153,6 +158,12 @@ ics::servo_id ics_servo::read_id(bool for_id_write) {
                   fmt::format("the answer to {} is {:02X}, not an ID reply (E0 + ID): a corrupt line, or no ICS servo",
                               where, rx.back()),
                   "one servo alone on the adapter, its own supply; a corrupt reply is never used");
+  if (p.error == errc::ics_line_echo_mismatch)
+    throw refused(refusal_kind::board,
+                  fmt::format("the echo of {} differs from what was sent (received {}): a collision on the line, or a "
+                              "port that is no ICS adapter (an adapter in ICS mode returns every byte sent)",
+                              where, hex(rx)),
+                  "one servo alone on an adapter in ICS mode");
   if (!p.ok() || rx.size() != p.consumed)
     throw refused(refusal_kind::board,
                   fmt::format("more than one device answers {} (received {}): the ID command talks to every "
@@ -170,7 +181,14 @@ ics::servo_id ics_servo::set_id(ics::servo_id id) {
         refusal_kind::board,
         fmt::format("the one servo on the line answers as ID {}, not {}: nothing written", alone.value(), id_.value()));
   if (alone == id) return id_;  // already: nothing to write
-  (void)ask(ics::write_id(id), o_.write_timeout, "ID write");
+  try {
+    (void)ask(ics::write_id(id), o_.write_timeout, "ID write");
+  } catch (const refused& e) {
+    if (e.kind != refusal_kind::timeout) throw;
+    throw refused(
+        e.kind, e.what(),
+        fmt::format("the servo may hold ID {} already, or still {}: `rcb4 ics id` tells", id.value(), id_.value()));
+  }
   const auto now = read_id(true);
   if (now != id)
     throw refused(
@@ -194,19 +212,21 @@ ics::eeprom_image ics_servo::read_eeprom() {
 }
 
 ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::eeprom_image want,
-                                         const ics_backup& save) {
+                                         const ics_backup& save, bool dry_run) {
   // The rules of ics.md §5.3: check mark, factory bytes, ID and the baud byte's high nibble as read.
   want = want.with_factory_of(before);
   want.set_id(id_);
   (void)want.set_raw(1, before.bytes()[0]);
   (void)want.set_raw(2, before.bytes()[1]);
   (void)want.set_raw(27, before.bytes()[26]);
+  // Byte 16: bit 2 (fixed, ics.md §4.3) and bit 1 (FREE, a status) as read; PWMINH and reverse as asked.
+  (void)want.set_raw(16, static_cast<std::uint8_t>((want.bytes()[15] & 0x9u) | (before.bytes()[15] & 0x6u)));
   ics_eeprom_report r;
   r.before = before;
   for (const auto& i : ics::fields)
     if (want.get(i.f) != before.get(i.f)) r.changed.emplace_back(i.f, want.get(i.f));
-  if (want == before) {
-    r.after = before;
+  if (want == before || dry_run) {
+    r.after = want;
     return r;
   }
   r.backup = save(before);
@@ -258,6 +278,9 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
   }
   if (r.after != want) {
     std::string diff;
+    for (const auto& i : ics::fields)
+      if (r.after.get(i.f) != want.get(i.f))
+        diff += fmt::format(" {} {} not {};", i.name, r.after.get(i.f), want.get(i.f));
     for (std::size_t n = 0; n < ics::eeprom_image::size; ++n)
       if (r.after.bytes()[n] != want.bytes()[n])
         diff += fmt::format(" byte {}: {:X} not {:X};", n + 1, r.after.bytes()[n], want.bytes()[n]);
@@ -265,6 +288,7 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
                   fmt::format("ICS servo {}: the EEPROM read back differs from what was written:{}", id_.value(), diff),
                   fmt::format("the old image is in {}", r.backup), r.backup);
   }
+  r.verified = true;
   return r;
 }
 
@@ -280,7 +304,7 @@ void check_silence(const ics::eeprom_image& before, const ics::eeprom_image& wan
 }  // namespace
 
 ics_eeprom_report ics_servo::set_fields(const std::vector<std::pair<ics::field, long>>& changes, const ics_backup& save,
-                                        bool force) {
+                                        bool force, bool dry_run) {
   if (changes.empty()) throw refused(refusal_kind::usage, "nothing to set: give FIELD=VALUE");
   for (std::size_t i = 0; i < changes.size(); ++i) {
     const auto& inf = ics::info(changes[i].first);
@@ -294,12 +318,16 @@ ics_eeprom_report ics_servo::set_fields(const std::vector<std::pair<ics::field, 
   }
   const auto before = read_eeprom();
   auto want = before;
-  for (const auto& [f, v] : changes) (void)want.set(f, v);
+  for (const auto& [f, v] : changes)
+    if (want.get(f) != v) (void)want.set(f, v);  // a field that holds the value keeps its bytes
   check_silence(before, want, force);
-  return write_image(before, want, save);
+  auto r = write_image(before, want, save, dry_run);
+  if (want.get(field::dead_band) > 5 && want.get(field::dead_band) != before.get(field::dead_band))
+    r.notes.push_back("KONDO's manual gives the dead band as 0-5 in one place and 0-10 in another: above 5 is untried");
+  return r;
 }
 
-ics_eeprom_report ics_servo::restore(const ics::eeprom_image& image, bool force, const ics_backup& save) {
+ics_eeprom_report ics_servo::restore(const ics::eeprom_image& image, bool force, const ics_backup& save, bool dry_run) {
   const auto before = read_eeprom();
   if (!before.same_unit(image) && !force)
     throw refused(refusal_kind::board,
@@ -322,8 +350,25 @@ ics_eeprom_report ics_servo::restore(const ics::eeprom_image& image, bool force,
                                                      "file; nothing written",
                                                      i.name, v, i.min, i.max));
   }
+  for (const auto f : {field::stretch, field::stretch_1, field::stretch_2, field::stretch_3}) {
+    const auto n = ics::info(f).first;  // stored doubled: an odd byte pair is no value a servo keeps
+    if ((image.bytes()[n] & 1u) != 0 && image.bytes()[n] != before.bytes()[n])
+      throw refused(refusal_kind::usage,
+                    fmt::format("the backup's {} is stored odd (0x{:X}{:X}): a damaged or hand-edited file; nothing "
+                                "written",
+                                ics::info(f).name, image.bytes()[n - 1], image.bytes()[n]));
+  }
   check_silence(before, image, force);
-  auto r = write_image(before, image, save);
+  auto want = image;
+  const bool stranger = !before.same_unit(image);
+  if (stranger && want.get(field::user_offset) != before.get(field::user_offset))
+    (void)want.set(field::user_offset, before.get(field::user_offset));  // factory-adjusted for each unit
+  auto r = write_image(before, want, save, dry_run);
+  if (stranger && image.get(field::user_offset) != before.get(field::user_offset))
+    r.notes.push_back(
+        fmt::format("this servo keeps its own user_offset {} (the backup's {}: set per unit at the "
+                    "factory); `rcb4 ics set user_offset=N` changes it",
+                    before.get(field::user_offset), image.get(field::user_offset)));
   if (image.get(field::id) != id_.value())
     r.notes.push_back(
         fmt::format("the backup was taken from ID {}: the servo keeps ID {} (`rcb4 ics id set` changes it)",
@@ -345,9 +390,11 @@ std::uint16_t ics_servo::free() { return ask(ics::set_position::free(id_), o_.ti
 
 std::uint16_t ics_servo::position() {
   try {
-    return ask(ics::read_position(id_), o_.timeout, "position read (SC 5)");
+    const auto p = ask(ics::read_position(id_), o_.timeout, "position read (SC 5)");
+    ics36_ = true;
+    return p;
   } catch (const refused& r) {
-    if (r.kind != refusal_kind::timeout) throw;
+    if (r.kind != refusal_kind::timeout || ics36_) throw;  // it answered SC 5 before: it stopped answering
     throw refused(refusal_kind::board,
                   fmt::format("ICS servo {} does not answer the ICS 3.6 position read (SC 5): an ICS 3.5 servo tells "
                               "its position only in reply to a move or a free",
@@ -372,7 +419,7 @@ std::uint8_t ics_servo::write(ics::sub what, long value) {
 }
 
 std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> bauds, const ics_options& o,
-                                const std::function<void(std::uint32_t)>& on_baud) {
+                                const std::function<void(std::uint32_t)>& on_baud, std::optional<ics::servo_id> only) {
   std::vector<std::uint32_t> order(bauds.begin(), bauds.end());
   if (order.empty()) order.assign(std::begin(ics::bauds), std::end(ics::bauds));
   for (const auto b : order)
@@ -390,7 +437,9 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
     (void)l.linger(o.timeout);
     if (heard.size() <= probe.size) continue;
     for (unsigned n = 0; n <= ics::servo_id::max; ++n) {
+      if (o.interrupted && o.interrupted()) break;
       const auto id = ics::servo_id::make(n).value();
+      if (only && id != *only) continue;
       l.set_baud(b);
       try {
         ics_servo s(l, id, b, quick);

@@ -41,6 +41,10 @@ ics_backup ics_backup_in(const std::string& dir, ics::servo_id id) {
 }
 
 ics::eeprom_image load_ics_image(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    throw refused(refusal_kind::usage,
+                  fmt::format("{} is not a file: give a backup from `rcb4 ics eeprom backup`", path));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw refused(refusal_kind::usage, fmt::format("cannot read {}: {}", path, std::strerror(errno)));
   const std::vector<std::uint8_t> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -64,7 +68,10 @@ std::pair<ics::field, long> parse_ics_setting(std::string_view text) {
     std::string names;
     for (const auto& i : ics::fields)
       if (i.writable) names += fmt::format("{}{}", names.empty() ? "" : ", ", i.name);
-    throw refused(refusal_kind::usage, fmt::format("'{}': expected FIELD=VALUE with a field of {}", text, names));
+    throw refused(refusal_kind::usage,
+                  eq == std::string_view::npos
+                      ? fmt::format("'{}': expected FIELD=VALUE with a field of {}", text, names)
+                      : fmt::format("no EEPROM field is called '{}': the fields are {}", name, names));
   }
   if (!inf->writable)
     throw refused(refusal_kind::usage,
@@ -78,8 +85,10 @@ std::pair<ics::field, long> parse_ics_setting(std::string_view text) {
   else if (inf->nibbles == 0 && (v == "off" || v == "false" || v == "no"))
     value = 0;
   else {
-    const auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
-    if (ec != std::errc{} || p != v.data() + v.size() || v.empty())
+    const bool hex = v.size() > 2 && v[0] == '0' && (v[1] == 'x' || v[1] == 'X');  // 0x30, as `position` takes
+    const auto digits = hex ? v.substr(2) : v;
+    const auto [p, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value, hex ? 16 : 10);
+    if (ec != std::errc{} || p != digits.data() + digits.size() || v.empty())
       throw refused(refusal_kind::usage, inf->nibbles == 0 ? fmt::format("{}: '{}': give on or off", inf->name, v)
                                                            : fmt::format("{}: '{}' is not a number", inf->name, v));
   }

@@ -56,6 +56,7 @@ struct ics_options {
   std::chrono::milliseconds timeout{100};         ///< wait for a reply (beyond its wire time)
   std::chrono::milliseconds write_timeout{3000};  ///< wait for the reply to an EEPROM or ID write
   int tries = 3;                                  ///< tries of an exchange that timed out or came back garbled
+  std::function<bool()> interrupted;              ///< a scan stops between IDs once this says true (Ctrl-C)
 };
 
 /** One servo that answered a scan. */
@@ -71,10 +72,11 @@ struct ics_found {
 /**
  * Every servo on the line: at each of @p bauds (empty: all three) where anything answers the ID
  * read, each ID asked its stretch and speed (which changes nothing) and the ICS 3.6 position read;
- * @p on_baud is told each rate as it starts. The line is left at its first rate.
+ * @p on_baud is told each rate as it starts; @p only: that ID alone. The line is left at its first rate.
  */
 std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> bauds, const ics_options& o,
-                                const std::function<void(std::uint32_t)>& on_baud = {});
+                                const std::function<void(std::uint32_t)>& on_baud = {},
+                                std::optional<ics::servo_id> only = {});
 
 /** What an EEPROM change did. */
 struct ics_eeprom_report {
@@ -82,7 +84,8 @@ struct ics_eeprom_report {
   ics::eeprom_image after;                           ///< the image read back after the write
   std::vector<std::pair<ics::field, long>> changed;  ///< the fields whose value changed (new values)
   std::string backup;                                ///< where `before` was saved
-  bool written = false;                              ///< false: nothing differed, nothing was written
+  bool written = false;                              ///< false: nothing differed (or a dry run), nothing was written
+  bool verified = false;                             ///< written and read back equal (a slave cannot be read back)
   std::vector<std::string> notes;                    ///< what the user should know (a baud change, a kept ID)
 };
 
@@ -114,9 +117,11 @@ class ics_servo {
   /**
    * Finds the servo: at @p baud (or each rate in turn, 115200 first) and as @p id (or the ID that
    * the one device on the line gives). Refused when nothing answers (timeout), more than one device
-   * answers the ID read (board), or @p id does not answer at the rate given.
+   * answers the ID read (board), or @p id does not answer at the rate given. @p for_id_work: the ID
+   * command follows (its refusal's hint says to leave one servo alone rather than to name one).
    */
-  ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional<std::uint32_t> baud, ics_options o = {});
+  ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional<std::uint32_t> baud, ics_options o = {},
+            bool for_id_work = false);
 
   /** Its ID. */
   ics::servo_id id() const noexcept { return id_; }
@@ -141,14 +146,14 @@ class ics_servo {
    * that makes the servo stop answering (slave on) is refused (usage) unless @p force.
    */
   ics_eeprom_report set_fields(const std::vector<std::pair<ics::field, long>>& changes, const ics_backup& save,
-                               bool force = false);
+                               bool force = false, bool dry_run = false);
   /**
    * Writes @p image back: refused (board) when its factory bytes are another servo's, and (usage)
    * when it would make the servo stop answering (slave on), unless @p force; refused (usage) when a
    * field is beyond its range and not the servo's value now (a damaged file). The servo's own
    * factory bytes and ID are kept in any case.
    */
-  ics_eeprom_report restore(const ics::eeprom_image& image, bool force, const ics_backup& save);
+  ics_eeprom_report restore(const ics::eeprom_image& image, bool force, const ics_backup& save, bool dry_run = false);
 
   /** Moves to @p counts (3500-11500); returns where it stood as the command arrived. */
   std::uint16_t move(std::uint16_t counts);
@@ -164,10 +169,12 @@ class ics_servo {
  private:
   template <class Cmd>
   typename Cmd::reply_type ask(const Cmd& c, std::chrono::milliseconds wait, const char* what);
-  ics_eeprom_report write_image(const ics::eeprom_image& before, ics::eeprom_image want, const ics_backup& save);
+  ics_eeprom_report write_image(const ics::eeprom_image& before, ics::eeprom_image want, const ics_backup& save,
+                                bool dry_run);
   ics_link& l_;
   ics::servo_id id_{};
   ics_options o_;
+  bool ics36_ = false;  // it has answered the ICS 3.6 position read
 };
 
 /** An ics_link over a port with the same four calls (rcb4::transport::ics_port), kept by the caller. */
