@@ -200,3 +200,55 @@ TEST_CASE("ics service: a line that fails during the EEPROM write names the back
     CHECK(std::string(r.what()).find("may or may not") != std::string::npos);
   }
 }
+
+TEST_CASE("ics service: a restore keeps byte 16's fixed and FREE bits and refuses an odd stretch", "[ics]") {
+  auto l = one(2);
+  ics_servo s(l, {}, {});
+  const auto before = s.read_eeprom();
+  const ics_backup save = [](const ics::eeprom_image&) { return std::string("old.bin"); };
+  auto bits = before;
+  REQUIRE(bits.set_raw(16, static_cast<std::uint8_t>(before.bytes()[15] | 0x6)));
+  const auto r = s.restore(bits, false, save);
+  CHECK_FALSE(r.written);  // only bits rcb4 never writes differ
+  CHECK(s.read_eeprom() == before);
+  auto odd = before;
+  REQUIRE(odd.set_raw(4, 1));  // stretch stored 0x01: odd
+  CHECK(kind_of([&] { s.restore(odd, false, save); }) == refusal_kind::usage);
+  auto tuned = before;
+  REQUIRE(tuned.set(field::speed, 77));
+  const auto dry = s.restore(tuned, false, save, true);
+  CHECK_FALSE(dry.written);
+  CHECK(dry.backup.empty());
+  REQUIRE(dry.changed.size() == 1);
+  CHECK(s.read_eeprom() == before);
+  auto dry_set = s.set_fields({{field::punch, 3}}, save, false, true);
+  CHECK_FALSE(dry_set.written);
+  CHECK(s.read_eeprom() == before);
+}
+
+TEST_CASE("ics service: a forced restore from another unit keeps this unit's user offset", "[ics]") {
+  auto mine = one(2, 115200, 1);
+  auto other = one(2, 115200, 5);
+  ics_servo a(mine, {}, {});
+  ics_servo b(other, {}, {});
+  const ics_backup save = [](const ics::eeprom_image&) { return std::string("old.bin"); };
+  (void)b.set_fields({{field::user_offset, -9}, {field::stretch, 44}}, save);
+  const auto r = a.restore(b.read_eeprom(), true, save);
+  CHECK(r.after.get(field::stretch) == 44);
+  CHECK(r.after.get(field::user_offset) == 0);
+  CHECK(r.notes.size() >= 2);
+}
+
+TEST_CASE("ics service: a 3.6 servo that stops answering is not called ICS 3.5", "[ics]") {
+  ics_virtual_link l(ics::virtual_line({ics::virtual_servo{}}));
+  ics_servo s(l, {}, {});
+  (void)s.position();
+  (void)s.set_fields(
+      {{field::slave, 1}}, [](const ics::eeprom_image&) { return std::string("x"); }, true);
+  try {
+    (void)s.position();
+    FAIL("answered");
+  } catch (const refused& r) {
+    CHECK(r.kind == refusal_kind::timeout);
+  }
+}
