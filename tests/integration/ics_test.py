@@ -6,9 +6,11 @@
 import contextlib
 import json
 import os
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 
 sys.path.insert(0, os.path.dirname(__file__))
 from checks import check, finish, tool  # noqa: E402
@@ -139,8 +141,6 @@ with ics_serve() as pty:
     check(rc == 1 and one.get("arrived") is False and "still moving" in one.get("error", ""),
           f"--wait --max-wait 0.3 on a slow servo: exit 1, one JSON object ({out.strip()} {err.strip()})")
     # Ctrl-C ends a wait at its next read: exit 130, said, promptly
-    import signal
-    import time
     p = subprocess.Popen([RCB4, "--device", pty, "ics", "position", "130", "--wait", "--max-wait", "30"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     time.sleep(0.5)
@@ -242,6 +242,20 @@ with ics_serve("--servo-id", "2") as pty:
           f"set slave=on --force writes it, says it was not read back ({out.strip()} {err.strip()})")
     rc, _, err = ics(pty, "id")
     check(rc == 4, f"then the servo never answers ({err.strip()})")
+
+# unplugged during a wait: the line closes under a position read or its write
+srv = subprocess.Popen([RCB4, "ics", "serve", "--pty"], stdout=subprocess.PIPE, text=True)
+pty = srv.stdout.readline().strip()
+check(run("--device", pty, "ics", "speed", "3")[0] == 0, "speed 3 before the unplug")
+p = subprocess.Popen([RCB4, "--device", pty, "ics", "position", "130", "--wait", "--max-wait", "30"],
+                     stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+time.sleep(0.5)
+srv.kill()
+srv.wait(timeout=10)
+t0 = time.monotonic()
+out, err = p.communicate(timeout=20)
+check(p.returncode == 3 and "line closed" in err and "ser2net" not in err and time.monotonic() - t0 < 3,
+      f"unplugged during position --wait: exit 3 at once, in ICS words ({p.returncode}: {err.strip()})")
 
 rc, out, err = run("--device", "/dev/nonexistent-ics", "ics", "id")
 check(rc == 3, f"a missing device: exit 3 ({err.strip()})")

@@ -406,11 +406,13 @@ signal_catcher::signal_catcher() {
   act.sa_flags = 0;
   ::sigaction(SIGINT, &act, &old_int_);
   ::sigaction(SIGTERM, &act, &old_term_);
+  ::sigaction(SIGHUP, &act, &old_hup_);  // the terminal closed: clean up as for Ctrl-C
 }
 
 signal_catcher::~signal_catcher() {
   ::sigaction(SIGINT, &old_int_, nullptr);
   ::sigaction(SIGTERM, &old_term_, nullptr);
+  ::sigaction(SIGHUP, &old_hup_, nullptr);
 }
 
 bool signal_catcher::caught() noexcept { return signal_seen != 0; }

@@ -314,7 +314,7 @@ std::string_view plain_message(std::string_view what);
 failure explain(const std::error_code& ec, std::string_view what);
 
 /**
- * Catches SIGINT and SIGTERM while it lives (without SA_RESTART, so a blocking read returns), so
+ * Catches SIGINT, SIGTERM and SIGHUP while it lives (without SA_RESTART, so a blocking read returns), so
  * that a command can stop cleanly or undo what it did (hold the joints it freed) before it exits.
  * The previous handlers come back when it goes.
  */
@@ -330,6 +330,7 @@ class signal_catcher {
  private:
   struct sigaction old_int_ {};
   struct sigaction old_term_ {};
+  struct sigaction old_hup_ {};
 };
 
 }  // namespace cli

@@ -132,6 +132,8 @@ std::uint16_t target_of(const std::string& word) {
 int position(sv::ics_servo& s, const std::string& word, bool wait, std::chrono::milliseconds max_wait,
              const globals& g) {
   json j{{"id", s.id().value()}};
+  if (wait && (word.empty() || word == "free"))
+    throw usage_error("--wait goes with a move: position DEG|COUNTS --wait");
   if (word.empty()) {
     const auto p = s.position();
     j.update(position_json(p));
@@ -170,7 +172,11 @@ int position(sv::ics_servo& s, const std::string& word, bool wait, std::chrono::
   int best = std::abs(was - target);
   bool timed_out = false;
   for (;;) {
-    now = s.position();
+    try {
+      now = s.position();
+    } catch (const sv::refused& r) {  // it stopped answering part way: the move sent is in the answer too
+      throw failure(exit_of(r.kind), r.what(), r.hint, g.json ? j : json());
+    }
     const int off = std::abs(now - target);
     const auto t = std::chrono::steady_clock::now();
     if (off < best) best = off, closer_at = t;
@@ -398,10 +404,15 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   auto where = std::make_shared<std::string>();
   auto wait = std::make_shared<bool>(false);
   auto* pos = cmd->add_subcommand("position", "where it stands (ICS 3.6), or move it: DEG, COUNTS or free");
-  pos->add_option("TARGET", *where, "degrees (-135..135), counts (3500..11500) or free");
-  pos->add_flag("--wait", *wait, "after a move: read until it is there or stops getting closer (ICS 3.6)");
+  pos->add_option("TARGET", *where, "degrees (-135..135), counts (3500..11500) or free")
+      ->check(CLI::Validator(
+          [](std::string& v) { return v.empty() ? std::string("empty: give DEG, COUNTS or free") : std::string(); },
+          "DEG|COUNTS|free"));
+  auto* wait_flag =
+      pos->add_flag("--wait", *wait, "after a move: read until it is there or stops getting closer (ICS 3.6)");
   auto max_wait = std::make_shared<double>(5.0);
   pos->add_option("--max-wait", *max_wait, "with --wait: give up after S seconds (default 5)")
+      ->needs(wait_flag)
       ->type_name("S")
       ->check(CLI::Range(0.1, 600.0));
   on_servo(pos, ctx, ig, [&ctx, where, wait, max_wait](sv::ics_servo& s) {

@@ -7,6 +7,7 @@ namespace cli::ics_line {
 sv::ics_options options_of(const globals& g) {
   sv::ics_options o;
   o.timeout = g.timeout;
+  o.interrupted = [] { return signal_catcher::caught(); };  // Ctrl-C: no retry, a scan stops
   return o;
 }
 
@@ -20,10 +21,14 @@ int guarded(const std::function<int()>& f) {
   try {
     code = f();
   } catch (const boost::system::system_error& e) {
+    if (signal_catcher::caught()) fmt::print(stderr, "interrupted; what was under way ended so:\n");
     if (e.code() != rcb4::transport::transport_errc::closed) throw;
     throw failure(exit_io, fmt::format("the adapter's line closed ({})", plain_message(e.what())),
                   "unplugged, or the server of the pty stopped: plug it in again; `rcb4 ics eeprom show` tells what "
                   "the servo holds");
+  } catch (...) {
+    if (signal_catcher::caught()) fmt::print(stderr, "interrupted; what was under way ended so:\n");
+    throw;
   }
   if (signal_catcher::caught() && code == exit_ok) {
     fmt::print(stderr, "interrupted (what was under way was finished first)\n");

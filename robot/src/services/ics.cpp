@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <iterator>
 #include <system_error>
+#include <type_traits>
 
 namespace rcb4::robot::services {
 namespace {
@@ -65,9 +66,12 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
   std::string last;
   bool answered = false;
   // A write waits long for its answer (seconds): tried twice at most, not three times.
-  const bool slow = wait > o_.timeout;
-  const int tries = std::max(1, slow ? std::min(o_.tries, 2) : o_.tries);
+  const bool write = std::is_same_v<Cmd, ics::write_eeprom> || std::is_same_v<Cmd, ics::write_id>;
+  const int tries = std::max(1, write ? std::min(o_.tries, 2) : o_.tries);
+  int tried = 0;
   for (int attempt = 0; attempt < tries; ++attempt) {
+    if (attempt > 0 && o_.interrupted && o_.interrupted()) break;  // Ctrl-C: no further try
+    ++tried;
     const auto rx = l_.transact(req.view(), expect, wait_for(expect, l_.baud(), wait));
     const auto p = ics::parse_exchange(c, rx);
     if (p.ok() && rx.size() == p.consumed) return p.value;
@@ -87,10 +91,10 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
   }
   const auto who = fmt::format("ICS servo {} at {} baud", id_.value(), l_.baud());
   if (!answered)
-    throw refused(
-        refusal_kind::timeout,
-        fmt::format("{}: no answer to the {} ({} tries of {} ms)", who, what, std::max(1, o_.tries), wait.count()),
-        hint_wiring);
+    throw refused(refusal_kind::timeout,
+                  fmt::format("{}: no answer to the {} ({} {} of {} ms)", who, what, tried,
+                              tried == 1 ? "try" : "tries", wait.count()),
+                  hint_wiring);
   throw refused(refusal_kind::board, fmt::format("{}: bad answer to the {}: {}", who, what, last),
                 "one servo alone on the adapter, its own supply; a corrupt or garbled reply is never used");
 }
@@ -182,7 +186,7 @@ ics::servo_id ics_servo::set_id(ics::servo_id id) {
         fmt::format("the one servo on the line answers as ID {}, not {}: nothing written", alone.value(), id_.value()));
   if (alone == id) return id_;  // already: nothing to write
   try {
-    (void)ask(ics::write_id(id), o_.write_timeout, "ID write");
+    (void)ask(ics::write_id(id), std::max(o_.write_timeout, o_.timeout), "ID write");
   } catch (const refused& e) {
     if (e.kind != refusal_kind::timeout) throw;
     throw refused(
@@ -232,7 +236,7 @@ ics_eeprom_report ics_servo::write_image(const ics::eeprom_image& before, ics::e
   r.backup = save(before);
   const auto old_baud = l_.baud();
   try {
-    (void)ask(ics::write_eeprom(id_, want), o_.write_timeout, "EEPROM write");
+    (void)ask(ics::write_eeprom(id_, want), std::max(o_.write_timeout, o_.timeout), "EEPROM write");
   } catch (refused& e) {
     throw refused(e.kind, fmt::format("{}; the servo may or may not have taken the new image", e.what()),
                   fmt::format("read it with `rcb4 ics eeprom show`; the old image is in {} (`rcb4 ics eeprom "

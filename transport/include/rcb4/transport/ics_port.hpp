@@ -66,6 +66,8 @@ class ics_port {
     while (sent < request.size()) {
       if (!ready(POLLOUT, deadline)) throw system_error(transport_errc::timeout, "write to " + path_);
       const auto n = ::write(fd_, request.data() + sent, request.size() - sent);
+      if (n < 0 && (errno == EIO || errno == ENXIO || errno == ENODEV))  // unplugged, or the pty's server gone
+        throw system_error(transport_errc::closed, path_);
       if (n < 0 && errno != EAGAIN && errno != EINTR) throw system_error(os_error(errno), "write to " + path_);
       if (n > 0) sent += static_cast<std::size_t>(n);
     }
