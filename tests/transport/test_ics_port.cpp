@@ -18,18 +18,22 @@ TEST_CASE("ics_port: a reply in time, a silent line ends at the deadline", "[ics
   const int master = pty.release_master();
   t::ics_port port(pty.path(), 115200);
   CHECK(port.baud() == 115200);
-  std::thread servo([master] {  // echo and a reply, written in two pieces
+  // No Catch assertion inside the thread (Catch is not thread-safe): its results are checked after join.
+  ssize_t wrote_first = 0, wrote_rest = 0;
+  std::thread servo([master, &wrote_first, &wrote_rest] {  // echo and a reply, written in two pieces
     std::uint8_t buf[8];
     std::size_t got = 0;
     while (got < 2) got += static_cast<std::size_t>(std::max<ssize_t>(0, ::read(master, buf + got, 2 - got)));
     const std::uint8_t first[] = {0xAC, 0x04, 0x2C};
     const std::uint8_t rest[] = {0x04, 0x4B};
-    CHECK(::write(master, first, 3) == 3);
-    CHECK(::write(master, rest, 2) == 2);
+    wrote_first = ::write(master, first, 3);
+    wrote_rest = ::write(master, rest, 2);
   });
   const std::uint8_t req[] = {0xAC, 0x04};
   const auto rx = port.transact(req, 5, 1000ms);
   servo.join();
+  CHECK(wrote_first == 3);
+  CHECK(wrote_rest == 2);
   CHECK(rx == std::vector<std::uint8_t>{0xAC, 0x04, 0x2C, 0x04, 0x4B});
 
   const auto start = std::chrono::steady_clock::now();
@@ -49,9 +53,10 @@ TEST_CASE("ics_port: the other end going away is an error, not a hang", "[ics]")
   const int master = pty->release_master();
   t::ics_port port(pty->path(), 115200);
   pty.reset();  // the pty's own slave descriptor goes: only the port holds the line now
-  std::thread unplug([master] {
+  ssize_t heard = 0;
+  std::thread unplug([master, &heard] {
     std::uint8_t b;
-    CHECK(::read(master, &b, 1) == 1);  // the request arrived: now unplug
+    heard = ::read(master, &b, 1);  // the request arrived: now unplug
     ::close(master);
   });
   const std::uint8_t req[] = {0xFF, 0x00, 0x00, 0x00};
@@ -64,6 +69,7 @@ TEST_CASE("ics_port: the other end going away is an error, not a hang", "[ics]")
   }
   CHECK(std::chrono::steady_clock::now() - start < 4s);
   unplug.join();
+  CHECK(heard == 1);
 }
 
 TEST_CASE("ics_port: a port another program holds is refused", "[ics]") {
