@@ -28,20 +28,29 @@ struct ics_globals {
   long long id = -1;             ///< --id, or -1: the one servo on the line
   long long scan_timeout = 30;   ///< scan: ms per ID
   std::string backup_dir = ".";  ///< where set and restore save the old image
+  /** The ID --id names, or nothing. */
+  std::optional<ics::servo_id> servo() const {
+    return id >= 0 ? std::optional(ics::servo_id::make(id).value()) : std::nullopt;
+  }
 };
 
-/** Runs @p f on the servo --id names (or the one on the line), found at --baud or each rate. */
+/**
+ * Runs @p f, guarded, on the servo --id names (or the one on the line), found at --baud or each
+ * rate; @p id_work: the ID command follows (see ics_servo).
+ */
+int with_servo(const context& ctx, const ics_globals& ig, const std::function<int(sv::ics_servo&)>& f,
+               bool id_work = false) {
+  return guarded([&] {
+    line l(ctx.g);
+    sv::ics_servo s(l.get(), ig.servo(), ctx.g.baud, options_of(ctx.g), id_work);
+    return f(s);
+  });
+}
+
+/** Makes @p cmd, when chosen, run @p f with_servo. */
 void on_servo(CLI::App* cmd, context& ctx, const std::shared_ptr<ics_globals>& ig, std::function<int(sv::ics_servo&)> f,
               bool id_work = false) {
-  on_run(cmd, ctx, [&ctx, ig, f, id_work] {
-    return guarded([&] {
-      line l(ctx.g);
-      std::optional<ics::servo_id> id;
-      if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
-      sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g), id_work);
-      return f(s);
-    });
-  });
+  on_run(cmd, ctx, [&ctx, ig, f, id_work] { return with_servo(ctx, *ig, f, id_work); });
 }
 
 double deg(std::uint16_t counts) { return std::round(ics::position::degrees(counts) * 100) / 100; }
@@ -230,11 +239,7 @@ void add_eeprom_commands(CLI::App* ics_cmd, context& ctx, const std::shared_ptr<
     ctx.action = [&ctx, ig, shown] {
       if (!shown->empty())
         return show_image(sv::load_ics_image(*shown), fmt::format("{}: EEPROM backup", *shown), ctx.g);
-      return guarded([&] {
-        line l(ctx.g);
-        std::optional<ics::servo_id> id;
-        if (ig->id >= 0) id = ics::servo_id::make(ig->id).value();
-        sv::ics_servo s(l.get(), id, ctx.g.baud, options_of(ctx.g));
+      return with_servo(ctx, *ig, [&](sv::ics_servo& s) {
         return show_image(s.read_eeprom(), fmt::format("ICS servo {} at {} baud: EEPROM", s.id().value(), s.baud()),
                           ctx.g);
       });
@@ -299,8 +304,7 @@ void add_ics_commands(CLI::App& app, context& ctx) {
       o.interrupted = [] { return signal_catcher::caught(); };
       std::vector<std::uint32_t> bs;
       if (ctx.g.baud) bs.push_back(*ctx.g.baud);
-      std::optional<ics::servo_id> only;
-      if (ig->id >= 0) only = ics::servo_id::make(ig->id).value();
+      const auto only = ig->servo();
       const auto found = sv::ics_scan(
           l.get(), bs, o,
           [&ctx, only](std::uint32_t b) {
@@ -362,18 +366,17 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   id->callback([&ctx, ig, id_set] {
     if (id_set->parsed()) return;
     ctx.action = [&ctx, ig] {
-      return guarded([&] {
-        line l(ctx.g);
-        std::optional<ics::servo_id> want;
-        if (ig->id >= 0) want = ics::servo_id::make(ig->id).value();
-        sv::ics_servo s(l.get(), want, ctx.g.baud, options_of(ctx.g), true);
-        const auto n = s.read_id();
-        if (ctx.g.json)
-          emit(json{{"id", n.value()}, {"baud", s.baud()}});
-        else
-          fmt::print("{}\n", n.value());
-        return exit_ok;
-      });
+      return with_servo(
+          ctx, *ig,
+          [&](sv::ics_servo& s) {
+            const auto n = s.read_id();
+            if (ctx.g.json)
+              emit(json{{"id", n.value()}, {"baud", s.baud()}});
+            else
+              fmt::print("{}\n", n.value());
+            return exit_ok;
+          },
+          true);
     };
   });
   add_eeprom_commands(cmd, ctx, ig);
@@ -391,11 +394,7 @@ void add_ics_commands(CLI::App& app, context& ctx) {
   on_run(set, ctx, [&ctx, ig, settings, set_force, set_dry] {
     std::vector<std::pair<ics::field, long>> changes;
     for (const auto& w : *settings) changes.push_back(sv::parse_ics_setting(w));  // before the line opens
-    return guarded([&] {
-      line l(ctx.g);
-      std::optional<ics::servo_id> sid;
-      if (ig->id >= 0) sid = ics::servo_id::make(ig->id).value();
-      sv::ics_servo s(l.get(), sid, ctx.g.baud, options_of(ctx.g));
+    return with_servo(ctx, *ig, [&](sv::ics_servo& s) {
       return print_report(s.set_fields(changes, sv::ics_backup_in(ig->backup_dir, s.id()), *set_force, *set_dry), ctx.g,
                           join(*settings), *set_dry);
     });
