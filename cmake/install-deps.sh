@@ -1,6 +1,10 @@
 #!/usr/bin/env bash
 # Installs from Debian 12 whatever the project needs and is missing; does nothing when all is there.
 # Usage: cmake/install-deps.sh            (needs root or sudo only when something is missing)
+#        cmake/install-deps.sh --list     (prints the packages, one a line: tests/deps_test.py checks
+#                                           that everything the suite runs comes from them)
+# Only these packages and what they *depend* on are installed (--no-install-recommends): a program
+# or module the suite uses that another package merely recommends must be listed here itself.
 set -euo pipefail
 
 packages=(
@@ -15,6 +19,7 @@ packages=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # the codec built for firmware
   qemu-system-arm                      # runs the example firmware (examples/firmware) in the suite
   python3                              # a client in another language for the virtual board tests
+  python3-venv python3-setuptools      # python.pip_install: pip in a venv builds pyrcb4 with Debian's setuptools
   ser2net                              # TCP bridge used by the transport tests
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
@@ -26,6 +31,11 @@ packages=(
   python3-std-srvs python3-std-msgs python3-diagnostic-msgs python3-rosservice python3-rosnode python3-roslaunch \
   python3-actionlib python3-actionlib-msgs python3-genpy python3-genmsg  # rcb4_ros: ROS 1's Python side only (its C++ packages would remove libboost1.81-dev); genpy generates the messages Debian lacks
 )
+
+if [ "${1:-}" = --list ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${packages[@]}"; do
