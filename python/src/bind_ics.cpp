@@ -184,7 +184,15 @@ std::string setting_text(const std::string& name, const py::handle& v) {
       if (i.writable) names += fmt::format("{}{}", names.empty() ? "" : ", ", i.name);
     throw board_error(fault::usage, fmt::format("set: {}: no such field (the fields: {})", name, names));
   }
-  if (py::isinstance<py::bool_>(v)) return name + (v.cast<bool>() ? "=on" : "=off");
+  const auto* inf = ics::find_field(name);
+  if (py::isinstance<py::bool_>(v)) {
+    if (inf->nibbles != 0)
+      throw board_error(fault::usage, fmt::format("set: {}={}: a number, not True or False", name,
+                                                  v.cast<bool>() ? "True" : "False"));
+    return name + (v.cast<bool>() ? "=on" : "=off");
+  }
+  if (inf->nibbles == 0 && py::isinstance<py::str>(v))  // a flag takes the tool's words too: on/off, yes/no, true/false
+    return name + "=" + v.cast<std::string>();
   return name + "=" + std::to_string(whole_of(v, "set: " + name));
 }
 

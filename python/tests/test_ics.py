@@ -83,7 +83,12 @@ def test_eeprom_fields(servo):
     assert len(raw) == 64 and e["raw"] == raw and raw[:2] == b"\x05\x0a" and max(raw) <= 0x0F
     assert e["stretch"] == 60 and e["speed"] == 127 and e["baud"] == 115200 and e["id"] == 0
     assert e["max_limit"] == 11500 and e["min_limit"] == 3500
-    assert e["reverse"] is False and e["pwm_inhibit"] is True and e["free"] is False
+    assert e["reverse"] is False and e["pwm_inhibit"] is True
+    assert e["free"] is True  # the virtual servo powers on limp, and its FREE status bit says so
+    servo.move(degrees=10)
+    assert servo.eeprom()["free"] is False  # holding now
+    servo.free()
+    assert servo.eeprom()["free"] is True
     assert [k for k in e if k != "raw"] == ["stretch", "speed", "punch", "dead_band", "damping", "safe_timer", "slave",
                                            "rotation", "pwm_inhibit", "free", "reverse", "max_limit", "min_limit",
                                            "baud", "temperature_limit", "current_limit", "response", "user_offset",
@@ -128,6 +133,12 @@ def test_set_flags_and_backup_dir(servo, tmp_path):
     e = servo.eeprom()
     assert e["reverse"] is True and e["punch"] == 3 and e["user_offset"] == -5
     assert servo.set(reverse=False)["changed"] == {"reverse": False}
+    assert servo.set(reverse="on")["changed"] == {"reverse": True}  # the tool's words, as `rcb4 ics set` takes
+    assert servo.set(reverse="no")["changed"] == {"reverse": False}
+    with pytest.raises(pyrcb4.UsageError, match="give on or off"):
+        servo.set(reverse="maybe")
+    with pytest.raises(pyrcb4.UsageError, match="a number, not True or False"):
+        servo.set(stretch=True)
     assert servo.set(punch=3)["written"] is False  # already so: nothing written, no backup
 
 

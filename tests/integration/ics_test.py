@@ -114,7 +114,7 @@ with ics_serve() as pty:
         f.write(good[:27] + bytes([5]) + good[28:])
     with open("odd.bin", "wb") as f:
         f.write(good[:2] + bytes([5, 1]) + good[4:])
-    for name, words in (("stretch0.bin", "stretch is 0, beyond 1..127"), ("baud5.bin", "baud code is 5"),
+    for name, words in (("stretch0.bin", "stretch 0 (rcb4's range 1..127)"), ("baud5.bin", "baud code is 5"),
                         ("odd.bin", "stored odd")):
         rc, _, err = ics(pty, "eeprom", "restore", name)
         check(rc == 2 and words in err and raw(pty) == before, f"restore {name}: exit 2, nothing written ({err.strip()})")

@@ -111,14 +111,20 @@ int show_image(const ics::eeprom_image& e, const std::string& title, const globa
   for (auto b : e.bytes()) raw += fmt::format("{}{:02X}", raw.empty() ? "" : " ", b);
   if (g.json) {
     json j;
-    for (const auto& i : ics::fields)
+    json odd = json::array();
+    for (const auto& i : ics::fields) {
       j[std::string(i.name)] = i.nibbles == 0 ? json(e.get(i.f) != 0) : json(e.get(i.f));
+      if (e.stored_odd(i.f)) odd.push_back(std::string(i.name));
+    }
+    if (!odd.empty()) j["stored_odd"] = odd;  // stretch fields another tool stored odd: the value is N.5
     j["raw"] = raw;
     emit(j);
     return exit_ok;
   }
   fmt::print("{}\n", title);
-  for (const auto& i : ics::fields) fmt::print("  {:<18} {:<22} {}\n", i.name, value_text(i.f, e.get(i.f)), i.what);
+  for (const auto& i : ics::fields)
+    fmt::print("  {:<18} {:<22} {}\n", i.name,
+               e.stored_odd(i.f) ? fmt::format("{}.5 (stored odd)", e.get(i.f)) : value_text(i.f, e.get(i.f)), i.what);
   fmt::print("  raw {}\n", raw);
   return exit_ok;
 }

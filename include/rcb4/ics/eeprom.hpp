@@ -146,6 +146,15 @@ class eeprom_image {
   }
 
   /**
+   * True when @p f is a stretch field stored odd: no ICS command writes that (stretch is stored
+   * doubled, ics.md §4.2), but another tool can; get() shows the value halved, rounded down.
+   */
+  constexpr bool stored_odd(field f) const noexcept {
+    const bool stretch = f == field::stretch || f == field::stretch_1 || f == field::stretch_2 || f == field::stretch_3;
+    return stretch && (number(info(f).first, 2) & 1u) != 0;
+  }
+
+  /**
    * Sets @p f to @p v (command units), only the field's own bits: errc::ics_value_out_of_range
    * outside the field's range, or for a field that cannot be set (free, id: use set_id()).
    */

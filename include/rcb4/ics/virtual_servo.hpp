@@ -8,7 +8,8 @@
 //    set by speed (model: 600°/s at 127), current while it moves, a temperature on ICSSW's scale.
 //    ID 0 at 115200 answers a position with header 0x80 (ics.md §2.1). A 3.5 servo ignores SC 5.
 //    An EEPROM image it could not run with (ID past 31, unknown baud code) is ignored (model).
-//    It stops at its EEPROM limits (model).
+//    It stops at its EEPROM limits (model). EEPROM byte 16 bit 1 (FREE) shows whether it is limp,
+//    a status that a written image never sets (ICSSW p23, ics.md §4.3).
 //  - virtual_line: the wire: every byte comes back (the echo, ics.md §1), then the replies of every
 //    servo that understood the frame, one after another (all of them for an ID command). A servo
 //    at another rate than the line's understands nothing. Misbehaviours for tests: silent, replies
@@ -65,6 +66,7 @@ class virtual_servo {
         (void)image_.set_raw(n, static_cast<std::uint8_t>(x & 0x0F));
       }
     image_.set_id(id);
+    show_free();
     load_live();
   }
 
@@ -114,6 +116,7 @@ class virtual_servo {
       put({static_cast<std::uint8_t>(compat ? 0x80 : me), position::high(now), position::low(now)});
       from_ = now, from_t_ = t;
       free_ = p->target() == position::free;
+      show_free();
       // model: it stops at its EEPROM limits
       target_ = free_ ? now
                       : std::clamp<double>(p->target(), static_cast<double>(image_.get(field::min_limit)),
@@ -139,11 +142,19 @@ class virtual_servo {
       put({static_cast<std::uint8_t>(0x40 | me), 0x00});
       rebase(t);
       image_ = we->image();
+      show_free();  // the FREE bit is a status (ics.md §4.3): never taken from a written image
       load_live();
     }
   }
 
  private:
+  /** EEPROM byte 16 bit 1 follows the servo's state: set while it is limp (ICSSW p23, ics.md §4.3). */
+  void show_free() noexcept {
+    const auto& f = info(field::free);
+    const auto b = image_.bytes()[f.first - 1u];
+    const auto bit = static_cast<std::uint8_t>(1u << f.bit);
+    (void)image_.set_raw(f.first, static_cast<std::uint8_t>(free_ ? (b | bit) : (b & ~bit)));
+  }
   void load_live() noexcept {
     stretch_ = static_cast<std::uint8_t>(image_.get(field::stretch));
     speed_ = static_cast<std::uint8_t>(image_.get(field::speed));

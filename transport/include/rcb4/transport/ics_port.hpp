@@ -50,7 +50,11 @@ class ics_port {
   void set_baud(std::uint32_t baud) {
     std::uint32_t rate = 0;
     bool parity = false;
-    if (const auto ec = detail::set_rcb4_line(fd_, baud, rate, parity)) throw system_error(ec, "set baud of " + path_);
+    if (const auto ec = detail::set_rcb4_line(fd_, baud, rate, parity)) {
+      if (ec.value() == EIO || ec.value() == ENXIO || ec.value() == ENODEV)  // unplugged, or the pty's server gone
+        throw system_error(transport_errc::closed, path_);
+      throw system_error(ec, "set baud of " + path_);
+    }
     baud_ = baud;
   }
 

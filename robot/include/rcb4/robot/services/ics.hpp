@@ -139,7 +139,11 @@ class ics_servo {
    */
   ics::servo_id set_id(ics::servo_id id);
 
-  /** The EEPROM image, checked (nibbles, check mark, its ID field the servo's own). */
+  /**
+   * The EEPROM image, checked (nibbles, check mark, its ID field the servo's own) and verified: read
+   * until two reads agree (at most four reads), since an image has no checksum and a byte that
+   * failed its parity check arrives as a valid 0x00; refused (board) with both images when no two agree.
+   */
   ics::eeprom_image read_eeprom();
   /**
    * Sets @p changes (ranges checked before anything is read), saving the old image first. A change
@@ -171,10 +175,12 @@ class ics_servo {
   typename Cmd::reply_type ask(const Cmd& c, std::chrono::milliseconds wait, const char* what);
   ics_eeprom_report write_image(const ics::eeprom_image& before, ics::eeprom_image want, const ics_backup& save,
                                 bool dry_run);
+  ics::eeprom_image read_eeprom_once();  // one read, checked but not verified against another
   ics_link& l_;
   ics::servo_id id_{};
   ics_options o_;
-  bool ics36_ = false;  // it has answered the ICS 3.6 position read
+  bool ics36_ = false;   // it has answered the ICS 3.6 position read
+  bool echoed_ = false;  // any byte came back (the echo at least): an ICS line
 };
 
 /** An ics_link over a port with the same four calls (rcb4::transport::ics_port), kept by the caller. */
