@@ -20,6 +20,8 @@ using rcb4::ops::memory;
 
 /** How often a called ROM motion's end is looked for (the board refreshes its state about as often). */
 constexpr std::chrono::milliseconds callee_poll = 50ms;
+/** How long after its time the last pose may take to be reached on the board before a note says so. */
+constexpr std::chrono::milliseconds settle_limit = 1000ms;
 
 compiled_motion checked(link& l, const model& robot, const rom_layout& layout, output_period period,
                         const motion_document& d, const std::string& file, bool rescale, servo_mask& on_board) {
@@ -89,7 +91,7 @@ std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::millise
     ready_ = now;
   }
   if (now < ready_) return ready_;
-  if (finished_) return std::nullopt;
+  if (finished_) return settled(now);
   const auto frame = std::chrono::milliseconds(rcb4::milliseconds(period_));
   for (;;) {
     const auto a = player_.next();
@@ -99,11 +101,11 @@ std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::millise
         throw refused(refusal_kind::usage,
                       fmt::format("{}: stopped at step {}: {}", file_, player_.step(), player_.error()));
       if (ready_ > now) return ready_;
-      return std::nullopt;
+      return settled(now);
     }
     if (const auto* snd = std::get_if<mo::send>(&a)) {
       if (const auto* c = std::get_if<rcb4::const_servo>(&snd->cmd))
-        for (const auto ics : c->targets().mask()) moved_.insert(ics);
+        for (const auto e : c->targets()) moved_.insert(e.ics), last_.insert(e.ics, e.value);
       run(l_, rcb4::ops::detail::ack_sequence({snd->cmd}));
       ready_ = std::max(ready_, now) + snd->frames * frame;
       if (ready_ > now) return ready_;
@@ -124,6 +126,26 @@ std::optional<std::chrono::milliseconds> host_play::advance(std::chrono::millise
       return now + callee_poll;
     }
   }
+}
+
+std::optional<std::chrono::milliseconds> host_play::settled(std::chrono::milliseconds now) {
+  // The host's clock says the last pose is due; the board began it at its first frame after the
+  // command arrived (the link's latency and up to one period later), so it is asked.
+  if (last_.empty()) return std::nullopt;
+  if (!settle_since_) settle_since_ = now;
+  const auto states = run(l_, rcb4::ops::read_servo_states());
+  bool there = true;
+  for (const auto& st : states)
+    if (const auto* want = last_.find(st.ics); want && st.target != want->value()) there = false;
+  if (there) return std::nullopt;
+  if (now - *settle_since_ >= settle_limit) {
+    compiled_.notes.push_back(
+        fmt::format("{}: the board had not reached the last pose {} ms after it was due (another "
+                    "program moved the servos?)",
+                    file_, settle_limit.count()));
+    return std::nullopt;
+  }
+  return now + std::max(std::chrono::milliseconds(1), std::chrono::milliseconds(rcb4::milliseconds(period_)));
 }
 
 void host_play::stop() {

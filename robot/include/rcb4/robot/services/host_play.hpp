@@ -48,7 +48,10 @@ class host_play {
 
   /**
    * Does what is due at @p now (since the play began; never going back) and returns when to be
-   * called next, or nothing once the motion has ended and its last pose is reached. Refused
+   * called next, or nothing once the motion has ended and its last pose is reached: the board's
+   * output position of every servo it moved equals its last target (read from the board, one
+   * output period apart, since the board starts a pose at its next frame after the command
+   * arrived; a note when it has not after a second). Refused
    * (usage) when the program stops on an error, (timeout) when a called ROM motion outlives its
    * limit (stopped on the board first).
    */
@@ -72,6 +75,7 @@ class host_play {
   output_period period() const noexcept { return period_; }
 
  private:
+  std::optional<std::chrono::milliseconds> settled(std::chrono::milliseconds now);
   link& l_;
   const rom_layout& layout_;
   output_period period_;
@@ -83,7 +87,9 @@ class host_play {
   std::chrono::milliseconds ready_{};                      ///< when the board has reached the last pose sent
   std::optional<std::chrono::milliseconds> callee_since_;  ///< a called ROM motion runs, since then
   std::optional<unsigned> callee_;
-  servo_mask moved_;  ///< the servos its poses moved (held where they are when it is stopped)
+  servo_mask moved_;                ///< the servos its poses moved (held where they are when it is stopped)
+  servo_set<servo_position> last_;  ///< each moved servo's last target sent
+  std::optional<std::chrono::milliseconds> settle_since_;  ///< the program ended: waiting for the board to get there
   bool finished_ = false;
 };
 
