@@ -148,6 +148,64 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check("beyond its limits" in message(driver)
               and js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose.head_yaw") == 15,
               f"300° on head_yaw is refused, the pose keeps 15 ({message(driver)!r})")
+        # Typed values are checked, never coerced (issue 41): with "live on the robot" ticked, what
+        # is no number (letters, an emptied box) marks the box, is not applied, sends nothing, and
+        # the robot does not move; a pose time below one board period is refused.
+        from selenium.webdriver.common.keys import Keys as K
+        click(driver, "id", "ed-live")
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 20) < 0.6, timeout=10)
+        knee_box = '.pose-joint[data-joint="left_knee"] input[type=number]'
+        for typed, what in (("--5", "letters (not a number)"), ("", "an emptied box")):
+            box = driver.find_element(By.CSS_SELECTOR, knee_box)
+            js(driver, "arguments[0].scrollIntoView({block: 'center'})", box)
+            box.send_keys(K.CONTROL, "a")
+            box.send_keys(K.DELETE)
+            if typed:
+                box.send_keys(typed)
+            box.send_keys(K.TAB)
+            time.sleep(0.6)  # three board periods and more: a move sent would show
+            kept = js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose.left_knee")
+            marked = js(driver, f"return document.querySelector('{knee_box}').classList.contains('invalid')")
+            check(kept == -20 and abs((measured(driver, "left_knee") or 0) + 20) < 0.6 and (marked or not typed),
+                  f"{what} in left_knee with live on: the pose keeps -20, the robot stays, "
+                  f"the box {'marked' if typed else 'restored'} ({kept}, {measured(driver, 'left_knee')}, {message(driver)!r})")
+        click(driver, "id", "ed-live")  # live off
+        for typed in ("--1", "", "0", "5"):
+            js(driver, "const t = document.querySelector('#ed-time'); t.value = arguments[0]; t.dispatchEvent(new Event('change'))", typed)
+            t = js(driver, "return window.rcb4Studio.editor.doc.steps[1].time_ms")
+            check(t == 400, f"pose time {typed!r}: refused or ignored, the pose keeps 400 ms ({t}, {message(driver)!r})")
+        # Undo covers a slider drag as one step (issue 41, M1): the motion as it was before the drag.
+        depth = js(driver, "return window.rcb4Studio.editor.history.undo")
+        js(driver, """const s = document.querySelector('.pose-joint[data-joint="head_yaw"] input[type=range]');
+                      for (const v of [16, 17, 18, 19, 20]) { s.value = v; s.dispatchEvent(new Event('input')); }
+                      s.dispatchEvent(new Event('change'));""")
+        yaw = lambda: js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose.head_yaw")  # noqa: E731
+        check(js(driver, "return window.rcb4Studio.editor.history.undo") == depth + 1 and yaw() == 20,
+              f"a drag 15 -> 20 is one undo step ({depth} -> {js(driver, 'return window.rcb4Studio.editor.history.undo')}, {yaw()})")
+        click(driver, "id", "ed-undo")
+        check(yaw() == 15, f"and Undo brings back 15, as before the drag ({yaw()})")
+        # Kept in the browser (issue 41, H3/H4): another page of this browser (a reload, a restarted
+        # rcb4 ui) opens with the same motion and the same undo history.
+        doc_now = js(driver, "return JSON.stringify(window.rcb4Studio.editor.doc)")
+        hist = js(driver, "return window.rcb4Studio.editor.history")
+        check(hist["dirty"], f"the motion has unsaved changes ({hist})")
+        first_tab = driver.current_window_handle
+        driver.switch_to.new_window("tab")
+        driver.get(ui.url)
+        wait_until(lambda: js(driver, "return !!(window.rcb4Studio && window.rcb4Studio.editor)"), timeout=20)
+        check(js(driver, "return JSON.stringify(window.rcb4Studio.editor.doc)") == doc_now
+              and js(driver, "return window.rcb4Studio.editor.history") == hist,
+              f"a new page of this browser has the motion and its history ({js(driver, 'return window.rcb4Studio.editor.history')})")
+        driver.close()
+        driver.switch_to.window(first_tab)
+        # Pulling over unsaved changes asks first; declined, the motion stays.
+        js(driver, "window.asked = null; window.savedConfirm = window.confirm; window.confirm = (m) => { window.asked = m; return false; }")
+        js(driver, "document.querySelector('#ed-slot').value = 2")
+        click(driver, "id", "ed-pull")
+        check(js(driver, "return window.asked") and "not saved" in js(driver, "return window.asked")
+              and js(driver, "return JSON.stringify(window.rcb4Studio.editor.doc)") == doc_now,
+              f"pull over unsaved changes asks, and when declined the motion stays ({js(driver, 'return window.asked')!r})")
+        js(driver, "window.confirm = window.savedConfirm; document.querySelector('#ed-slot').value = 10")
         # Previewed in 3D without the robot: the ghost moves at the authored timing.
         click(driver, "id", "ed-preview")
         shown = wait_until(lambda: "preview:" in driver.find_element(By.ID, "ed-result").text and

@@ -88,6 +88,9 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     b.send({"op": "move", "id": 5, "joints": {"left_knee": 10}})
     e = b.wait_for(lambda m: m["type"] == "error")
     check(e and e["id"] == 5 and "only watches" in e["message"], "a watching page cannot move the robot")
+    b.send({"op": "stop", "id": 6})
+    r = b.wait_for(lambda m: m.get("id") == 6)
+    check(r is not None and r["type"] == "reply", f"but it may Stop: every page keeps Stop (issue 41, M5) ({r})")
     for bad in ["", "{", "[]", "null", '{"op":"move","joints":{"left_knee":"10"}}', '{"op":"capture","name":"../x"}',
                 '{"op":"x"}', "\u00e9" * 100, '{"a":' * 50]:
         a.send_text(bad)
@@ -101,8 +104,21 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
     check(errors == 10, f"ten bad messages, ten errors ({errors})")
     a.send({"op": "refresh", "id": 77})
     check(a.wait_for(lambda m: m["type"] == "reply" and m["id"] == 77) is not None, "and the server still answers")
-    a.send_text("x" * 70000)
-    check(closed_within(a, 5), "a message over 64 KiB closes that page's socket")
+    # A motion file's text fits (issue 41: a file over 64 KiB dropped the page): a long message is
+    # answered, one over 4 MiB is refused unread with an error, one over the socket's limit
+    # (4 MiB + 64 KiB) closes that page's socket.
+    a.send({"op": "motion_check", "id": 78, "text": "# " + "x" * 200000 + "\n"})
+    r = a.wait_for(lambda m: m.get("id") == 78, timeout=10)
+    check(r is not None, f"a 200 KB motion file text is answered, the page stays connected ({(r or {}).get('message', r and r['type'])})")
+    a.send_text("x" * (4 * 1024 * 1024 + 1))
+    e = a.wait_for(lambda m: m["type"] == "error", timeout=10)
+    check(e is not None and "at most 4194304" in e["message"], f"a message over 4 MiB: an error, unread ({e})")
+    try:
+        a.send_text("x" * (4 * 1024 * 1024 + 64 * 1024 + 1))
+        closed = closed_within(a, 10)
+    except (BrokenPipeError, ConnectionResetError):  # closed while the message was still going out
+        closed = True
+    check(closed, "a message over the socket's limit closes that page's socket")
     # The controller went with it: a second page may take control; then it vanishes mid-move.
     took = None
     for attempt in range(30):  # the server learns of the closed page a moment after the client does
@@ -273,6 +289,8 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: "watching" in driver.find_element(By.ID, "role").text), "a second tab watches")
         check(not driver.find_element(By.CSS_SELECTOR, 'input[data-joint="head_yaw"]').is_enabled() and
               not driver.find_element(By.ID, "capture").is_enabled(), "its sliders and buttons are disabled")
+        check(driver.find_element(By.ID, "stop").is_enabled() and driver.find_element(By.ID, "motion-stop").is_enabled(),
+              "but Stop and Stop motion are not: a watching tab may stop the robot")
         # Reading a ROM motion as a motion file is for any page: the watching tab asks for motion 2.
         driver.find_element(By.CSS_SELECTOR, '#motions li[data-motion="2"] button[title^="the motion as"]').click()
         text = wait_until(lambda: driver.find_element(By.ID, "motion-file-text").text or None)

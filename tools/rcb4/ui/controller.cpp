@@ -171,6 +171,21 @@ void controller::handle(client_id c, const message& m, effects& e) {
     e.actions.push_back({c, m.id, studio_action{st->op, st->args}});
     return;
   }
+  // Stop is the one control every page keeps, a watching one too (its controlling page may hang or
+  // be on another screen): every joint holds where it is, a motion stops. It only ever stops.
+  if (std::holds_alternative<stop_request>(m.body)) {
+    pending_.clear();
+    for (auto& target : commanded_) target.reset();
+    stop_action s;
+    for (const auto& j : model_->joints()) s.joints.push_back(&j);
+    s.motion = true;
+    e.actions.push_back({c, m.id, std::move(s)});
+    return;
+  }
+  if (std::holds_alternative<motion_stop_request>(m.body)) {
+    e.actions.push_back({c, m.id, motion_stop_action{}});
+    return;
+  }
   if (controller_ != c) {
     refuse("this page only watches: take control first");
     return;
@@ -246,15 +261,6 @@ void controller::handle(client_id c, const message& m, effects& e) {
     e.actions.push_back({c, m.id, power_action{p->free, std::move(joints)}});
     return;
   }
-  if (std::holds_alternative<stop_request>(m.body)) {
-    pending_.clear();
-    for (auto& target : commanded_) target.reset();
-    stop_action s;
-    for (const auto& j : model_->joints()) s.joints.push_back(&j);
-    s.motion = true;
-    e.actions.push_back({c, m.id, std::move(s)});
-    return;
-  }
   if (const auto* cap = std::get_if<capture_request>(&m.body)) {
     e.actions.push_back({c, m.id, capture_action{cap->name, cap->force}});
     return;
@@ -269,10 +275,6 @@ void controller::handle(client_id c, const message& m, effects& e) {
     pending_.clear();
     started_motion_ = true;
     e.actions.push_back({c, m.id, motion_play_action{mp->slot}});
-    return;
-  }
-  if (std::holds_alternative<motion_stop_request>(m.body)) {
-    e.actions.push_back({c, m.id, motion_stop_action{}});
     return;
   }
 }

@@ -49,10 +49,16 @@
 
 namespace cli::ui {
 
-/** The longest message a page may send; longer ones are refused unread (a motion file's text fits). */
-inline constexpr std::size_t max_message_bytes = 64 * 1024;
-/** The longest motion file text a studio message may carry. */
-inline constexpr std::size_t max_text_bytes = 60 * 1024;
+/**
+ * The longest message a page may send; longer ones are refused unread, with a reply (a motion
+ * file's text fits, escaped as JSON). The WebSocket itself takes up to ws_frame_max before the
+ * server drops a page (a hostile one): every message the page makes stays well below.
+ */
+inline constexpr std::size_t max_message_bytes = 4 * 1024 * 1024;
+/** The WebSocket's own limit: above it the connection is closed (the page checks its messages first). */
+inline constexpr std::size_t ws_frame_max = max_message_bytes + 64 * 1024;
+/** The longest motion file text a studio message may carry (docs/browser.md: 512 KiB; a slot holds far less). */
+inline constexpr std::size_t max_text_bytes = 512 * 1024;
 /** The longest joint, group or pose name a message may carry. */
 inline constexpr std::size_t max_name_bytes = 64;
 /** The longest move or pose time a message may ask, ms (255 frames of 25 ms, protocol.md §5). */

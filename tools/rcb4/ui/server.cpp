@@ -172,7 +172,7 @@ class ws_session : public std::enable_shared_from_this<ws_session> {
     ws_.set_option(t);
     ws_.set_option(websocket::stream_base::decorator(
         [](websocket::response_type& res) { res.set(http::field::server, "rcb4 ui"); }));
-    ws_.read_message_max(max_message_bytes);
+    ws_.read_message_max(ws_frame_max);
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) { self->on_accept(ec); });
   }
 

@@ -2,7 +2,7 @@
 // studio's parts (view3d.js, editor.js, tables.js). One WebSocket to the server that owns the
 // board; nothing else is reached. Messages: tools/rcb4/ui/messages.hpp (to the server),
 // board_loop.cpp, controller.cpp and studio_ops.cpp (from it).
-import { $, el, breakable, fmtDeg } from './dom.js';
+import { $, el, breakable, fmtDeg, numberIn } from './dom.js';
 import { createView } from './view3d.js';
 import { createEditor } from './editor.js';
 import { createTables } from './tables.js';
@@ -91,7 +91,8 @@ const on = {
     ui.lastState = m;
     window.rcb4State = m;  // the tests and the benchmark read it
     renderState(m);
-    ui.hello?.joints.forEach((j, i) => { ui.measured[j.name] = m.angles[i]; });
+    // A board that does not answer: every angle unknown (never 0), and the drawn robot says so.
+    ui.hello?.joints.forEach((j, i) => { ui.measured[j.name] = m.answering ? m.angles[i] : null; });
     if (ui.studio) {
       ui.studio.view?.setMeasured(ui.measured);
       ui.studio.tables.running(m.motion.running ? m.motion.slot : null);
@@ -242,7 +243,7 @@ function renderState(s) {
     }
   });
   renderLink(s);
-  renderMotion(s.motion);
+  renderMotion(s.motion, s.answering);
   recordSensors(s);
 }
 
@@ -296,8 +297,10 @@ function renderPoses(poses, dir) {
 }
 
 function playPose(name) {
-  const ms = Number($('#pose-ms').value);
-  send({ op: 'play_pose', name, ms: Number.isFinite(ms) ? Math.min(Math.max(Math.round(ms), 0), 6375) : undefined });
+  // the time the pose is played over: checked, never coerced (letters are no 0 ms snap)
+  const r = numberIn($('#pose-ms'), { min: 10, max: 6375, whole: true, what: 'play over', unit: ' ms' });
+  if (r.value === null) return say(r.why || 'play over: type a time in ms (10 to 6375)', 'error');
+  send({ op: 'play_pose', name, ms: r.value });
 }
 
 // A ROM motion read back as a motion file: shown, and saved by the browser (rcb4 motion push reads it).
@@ -324,8 +327,10 @@ function renderMotions() {
   setRole(ui.role, ui.controlled);
 }
 
-function renderMotion(m) {
-  const text = m.suspended ? (m.slot ? `motion ${m.slot} stopped part way` : 'the ROM program is stopped')
+function renderMotion(m, answering = true) {
+  // A board that does not answer tells nothing: its motion may still run (a cable out).
+  const text = !answering ? 'motion unknown: the board does not answer (it may still be playing one)'
+    : m.suspended ? (m.slot ? `motion ${m.slot} stopped part way` : 'the ROM program is stopped')
     : m.running ? (m.slot ? `motion ${m.slot} running` : 'the ROM program runs outside the motion slots')
     : 'no motion running';
   $('#motion-state').textContent = text;

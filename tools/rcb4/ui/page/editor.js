@@ -4,7 +4,7 @@
 // services): pushed to a slot with its backup named, pulled from one, played from the host at the
 // authored timing, previewed in 3D without the robot, opened from and saved to a file.
 
-import { el, $ } from './dom.js';
+import { el, $, numberIn } from './dom.js';
 
 const KINDS = {
   pose: () => null,  // made from the robot or the ghost
@@ -106,6 +106,9 @@ export function at(segs, t) {
   return segs.length ? segs[segs.length - 1].to : null;
 }
 
+/** The largest motion file the editor opens (the server's max_text_bytes, docs/browser.md). */
+const MAX_FILE_BYTES = 512 * 1024;
+
 export function createEditor(root, ctx) {
   const h = ctx.hello;
   const limits = new Map(h.joints.map((j) => [j.name, j]));
@@ -114,6 +117,12 @@ export function createEditor(root, ctx) {
   // --- the parts of the panel ---
   const name = el('input', { id: 'ed-name', placeholder: 'motion name (names its slot)', maxlength: 64, 'aria-label': 'motion name' });
   const slot = el('input', { id: 'ed-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot number' });
+  /** The slot typed, 1-120, or null (said, the box marked): nothing is read or written then. */
+  const slotIn = () => {
+    const r = numberIn(slot, { min: 1, max: 120, whole: true, what: 'the slot' });
+    if (r.value === null) ctx.say(r.why || 'type a slot number, 1 to 120', 'error');
+    return r.value;
+  };
   const file = el('input', { id: 'ed-file', type: 'file', accept: '.yaml,.yml,.json', hidden: true });
   const kind = el('select', { id: 'ed-kind', 'aria-label': 'kind of step to add' },
     ...Object.keys(KINDS).map((k) => el('option', { value: k, text: k.replace('_', ' ') })));
@@ -128,7 +137,7 @@ export function createEditor(root, ctx) {
   const bt = (id, text, title, fn, cls = '') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
   root.replaceChildren(
     el('div', { class: 'row' }, name,
-      bt('ed-new', 'New', 'an empty motion', () => load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] })),
+      bt('ed-new', 'New', 'an empty motion', () => { if (mayReplace('New')) { load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] }); markClean(); } }),
       bt('ed-open', 'Open…', 'a motion file (.yaml) from this computer', () => file.click()), file,
       bt('ed-save', 'Save', 'download the motion as a motion file (.yaml), as rcb4 motion push reads it', save)),
     el('div', { class: 'row' }, 'slot', slot,
@@ -159,6 +168,45 @@ export function createEditor(root, ctx) {
   };
   function undo() { if (!ed.undo.length) return; ed.redo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.undo.pop())); render(); }
   function redo() { if (!ed.redo.length) return; ed.undo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.redo.pop())); render(); }
+
+  // --- kept in the browser: the motion, its undo history and what was last saved survive a
+  // reconnect (a restarted rcb4 ui), a reload and a closed tab (localStorage, one per robot) ---
+  const storeKey = `rcb4-studio-editor:${h.robot}`;
+  let storeFailed = false;
+  function keep() {
+    try {
+      localStorage.setItem(storeKey, JSON.stringify({ doc: ed.doc, sel: ed.sel, undo: ed.undo, redo: ed.redo, clean: ed.clean }));
+      storeFailed = false;
+    } catch (e) {
+      if (!storeFailed) ctx.say(`the browser would not keep the motion (${e.name}): save it to a file`, 'error');
+      storeFailed = true;
+    }
+  }
+  (function restore() {
+    try {
+      const kept = JSON.parse(localStorage.getItem(storeKey) || 'null');
+      if (!kept || !kept.doc || !Array.isArray(kept.doc.steps) || !kept.doc.steps.length) return;
+      ed.doc = kept.doc;
+      ed.sel = Number.isInteger(kept.sel) ? kept.sel : 0;
+      ed.undo = Array.isArray(kept.undo) ? kept.undo.filter((u) => typeof u === 'string') : [];
+      ed.redo = Array.isArray(kept.redo) ? kept.redo.filter((u) => typeof u === 'string') : [];
+      ed.clean = typeof kept.clean === 'string' ? kept.clean : null;
+    } catch { /* a damaged entry: start empty */ }
+  }());
+  ed.clean ??= snapshotDoc();
+  /** The motion as the dirty check sees it (the selection is no change). */
+  function snapshotDoc() { return JSON.stringify(ed.doc); }
+  /** True when the motion differs from what was last opened, pulled, saved or pushed. */
+  const dirty = () => snapshotDoc() !== ed.clean;
+  const markClean = () => { ed.clean = snapshotDoc(); keep(); };
+  window.addEventListener('beforeunload', (e) => {
+    if (!dirty()) return undefined;
+    e.preventDefault();  // the browser asks before the page goes (the motion is kept in the browser too)
+    e.returnValue = '';
+    return '';
+  });
+  /** Asks before @p what replaces a motion with unsaved changes; true: go ahead. */
+  const mayReplace = (what) => !dirty() || window.confirm(`The motion in the editor has changes not saved or pushed. ${what} replaces it (Undo brings it back). Go on?`);
 
   // --- steps ---
   const clampSel = () => { ed.sel = Math.min(Math.max(ed.sel, 0), ed.doc.steps.length - 1); };
@@ -228,6 +276,7 @@ export function createEditor(root, ctx) {
   // --- drawing ---
   function render() {
     clampSel();
+    keep();
     name.value = ed.doc.name || '';
     const segs = (() => { try { return segments(ed.doc.steps, ctx.measured()); } catch { return []; } })();
     steps.replaceChildren(...ed.doc.steps.map((s, i) => {
@@ -292,11 +341,17 @@ export function createEditor(root, ctx) {
       detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), el('div', { class: 'row' }, text, apply));
       return;
     }
-    const time = el('input', { id: 'ed-time', type: 'number', min: 0, max: 6375, step: 10, value: s.time_ms, 'aria-label': 'time of the pose in ms' });
+    // A pose takes one board period at least (0 ms would snap the robot to it) and 255 frames at most.
+    const period = ed.doc.period_ms || 10;
+    const time = el('input', { id: 'ed-time', type: 'number', min: period, max: 255 * period, step: period, value: s.time_ms, 'aria-label': 'time of the pose in ms' });
     time.addEventListener('change', () => {
-      const v = Math.round(Number(time.value));
-      if (!(v >= 0 && v <= 6375)) { time.classList.add('beyond'); return ctx.say('a pose takes 0 to 6375 ms', 'error'); }
-      change(() => { s.time_ms = v; });
+      const r = numberIn(time, { min: period, max: 255 * period, whole: true, what: 'the pose time', unit: ' ms' });
+      if (r.value === null) {
+        if (r.why) ctx.say(`${r.why} (a pose takes ${period} to ${255 * period} ms: one to 255 periods of ${period} ms)`, 'error');
+        else time.value = s.time_ms;  // emptied: nothing changes, the kept time back
+        return;
+      }
+      change(() => { s.time_ms = r.value; });
     });
     const live = el('input', { id: 'ed-live', type: 'checkbox', class: 'needs-control' });
     live.checked = !!ed.live;
@@ -310,7 +365,14 @@ export function createEditor(root, ctx) {
       const num = el('input', { type: 'number', step: 0.5, value: Math.round(v * 10) / 10, disabled: !on, 'aria-label': `${j.name} degrees, typed` });
       const row = el('div', { class: 'pose-joint' + (on && (v < j.lower || v > j.upper) ? ' beyond' : ''), 'data-joint': j.name },
         tick, el('span', { class: 'name', text: j.name }), slider, num);
-      tick.addEventListener('change', () => change(() => { if (tick.checked) s.pose[j.name] = Number(num.value) || 0; else delete s.pose[j.name]; }));
+      tick.addEventListener('change', () => {
+        if (!tick.checked) return change(() => { delete s.pose[j.name]; });
+        // the joint joins the pose at the angle its box shows, checked as a typed one is
+        const r = numberIn(num, { min: j.lower, max: j.upper, what: j.name, unit: '°' });
+        if (r.value === null) { tick.checked = false; return ctx.say(r.why || `${j.name}: type its angle first`, 'error'); }
+        change(() => { s.pose[j.name] = r.value; });
+        if (ed.live) sendLive({ [j.name]: r.value });
+      });
       const set = (x, commit) => {
         if (!(x >= j.lower && x <= j.upper)) {  // refused: said, shown red a moment, the kept value back
           row.classList.add('beyond');
@@ -322,9 +384,28 @@ export function createEditor(root, ctx) {
         if (commit) change(() => { s.pose[j.name] = x; }); else { s.pose[j.name] = x; ctx.view?.setGhost(poseAt(ed.sel)); }
         if (ed.live) sendLive({ [j.name]: x });
       };
-      slider.addEventListener('input', () => { num.value = slider.value; set(Number(slider.value), false); });
-      slider.addEventListener('change', () => { ed.undo.push(snapshot()); render(); });
-      num.addEventListener('change', () => set(Number(num.value), true));
+      // A drag is one undo step: the motion as it was before the drag's first movement.
+      let beforeDrag = null;
+      slider.addEventListener('input', () => {
+        beforeDrag ??= snapshot();
+        num.value = slider.value;
+        set(Number(slider.value), false);
+      });
+      slider.addEventListener('change', () => {
+        if (beforeDrag !== null && beforeDrag !== snapshot()) { ed.undo.push(beforeDrag); ed.redo = []; }
+        beforeDrag = null;
+        render();
+      });
+      num.addEventListener('change', () => {
+        // letters or a cleared box are no angle: marked, nothing applied, nothing sent, nothing moves
+        const r = numberIn(num, { what: j.name, unit: '°' });
+        if (r.value === null) {
+          if (r.why) ctx.say(r.why, 'error');
+          else num.value = s.pose[j.name];  // emptied: the kept angle back
+          return;
+        }
+        set(r.value, true);
+      });
       return row;
     });
     detail.replaceChildren(el('div', { class: 'row small' }, `step ${ed.sel + 1}: pose over`, time, 'ms',
@@ -346,15 +427,20 @@ export function createEditor(root, ctx) {
   }
   async function pull() {
     try {
-      const r = await ctx.request({ op: 'motion_pull', slot: Number(slot.value) });
+      const n = slotIn(); if (n === null) return;
+      if (!mayReplace(`Pulling slot ${n}`)) return ctx.say('pull cancelled: the motion in the editor is kept');
+      const r = await ctx.request({ op: 'motion_pull', slot: n });
       load(r.motion);
+      markClean();
       ctx.say(`motion ${r.slot} in the editor (${r.plays})` + (r.problem ? `; as it is, it would not push back: ${r.problem}` : ''));
     } catch (e) { ctx.say(e.message, 'error'); }
   }
   async function push() {
     try {
-      const r = await ctx.request({ op: 'motion_push', slot: Number(slot.value), text: text() });
+      const n = slotIn(); if (n === null) return;
+      const r = await ctx.request({ op: 'motion_push', slot: n, text: text() });
       const notes = r.notes?.length ? ` (${r.notes.join('; ')})` : '';
+      markClean();
       ctx.say(r.unchanged ? `motion ${r.slot} already holds these ${r.bytes} bytes: nothing written${notes}`
         : `wrote ${r.bytes} bytes to motion ${r.slot}: ${r.summary}; the old bytes are in ${r.backup}${notes}`);
       $('#ed-result').textContent = r.unchanged ? '' : `backup: ${r.backup}`;
@@ -366,6 +452,7 @@ export function createEditor(root, ctx) {
       const r = await ctx.request({ op: 'motion_check', text: text() });
       const a = el('a', { href: URL.createObjectURL(new Blob([r.yaml], { type: 'application/yaml' })), download: (name.value.trim() || 'motion').replace(/[^A-Za-z0-9_-]+/g, '_') + '.yaml' });
       a.click();
+      markClean();
       setTimeout(() => URL.revokeObjectURL(a.href), 5000);
       ctx.say(r.problem ? `saved, but as it is it would not play: ${r.problem}` : `saved (${r.plays})`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(e.message, 'error'); }
@@ -374,9 +461,13 @@ export function createEditor(root, ctx) {
     const f = file.files[0];
     if (!f) return;
     file.value = '';  // the same file chosen again opens again
+    if (f.size > MAX_FILE_BYTES)  // beyond what a page may send: refused here, the connection kept
+      return ctx.say(`${f.name}: ${Math.ceil(f.size / 1024)} KiB: a motion file may be up to ${MAX_FILE_BYTES / 1024} KiB (a slot holds a few KiB): not opened`, 'error');
+    if (!mayReplace(`Opening ${f.name}`)) return ctx.say('open cancelled: the motion in the editor is kept');
     try {
       const r = await ctx.request({ op: 'motion_check', text: await f.text() });
       load(r.motion);
+      markClean();
       ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
   });
@@ -411,6 +502,14 @@ export function createEditor(root, ctx) {
     ed.playing = true;
     const first = ed.doc.steps.find((s) => kindOf(s) === 'pose');
     try {
+      // The whole motion is checked before the robot moves into its first pose: a motion that
+      // will be refused moves nothing (the server checks it again when it plays it).
+      const checked = await ctx.request({ op: 'motion_check', text: text() });
+      if (run !== ed.run) return;
+      if (checked.problem) {
+        ed.playing = false;
+        return ctx.say(`not played: ${checked.problem} (nothing moved)`, 'error');
+      }
       if (first) {  // into the first pose at the speed limit; from there, the authored timing
         const r = await ctx.request({ op: 'move', joints: first.pose });
         await new Promise((done) => setTimeout(done, (r.ms ?? 0) + 50));
@@ -437,6 +536,8 @@ export function createEditor(root, ctx) {
   return {
     load, render,
     get doc() { return ed.doc; },
+    /** The undo and redo depths, and whether the motion has unsaved changes (tests). */
+    get history() { return { undo: ed.undo.length, redo: ed.redo.length, dirty: dirty() }; },
     /** A motion played from the host ended (the server's "played"). */
     played(m) { ed.playing = false; ctx.say(m.error ? `the play stopped: ${m.error}` : `played ${m.poses} poses in ${m.seconds} s`, m.error ? 'error' : 'note'); },
     stop,

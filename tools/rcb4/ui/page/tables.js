@@ -3,7 +3,7 @@
 // cleared, pressed and held to test a branch), trims (live, kept in ROM on request), the ROM backup.
 // Every change goes through the server's robot services, with their checks and refusals.
 
-import { el } from './dom.js';
+import { el, numberIn } from './dom.js';
 
 // The KRR remote's buttons (motion/buttons.hpp), laid out as on the pad: [name, column, row].
 const PAD = [['s1', 0, 0], ['s2', 1, 0], ['s3', 5, 0], ['s4', 6, 0],
@@ -49,7 +49,7 @@ export function createTables(root, ctx) {
     el('details', { id: 'buttons-panel' }, el('summary', {}, 'Remote buttons'), pad,
       el('div', { class: 'row' }, combo),
       el('div', { class: 'row' }, 'play slot', bslot,
-        bt('button-set', 'Assign', 'these buttons play the slot (ROM and RAM)', () => withCombo((b) => ask({ op: 'button_set', buttons: b, slot: Number(bslot.value) }, null, showEntries))),
+        bt('button-set', 'Assign', 'these buttons play the slot (ROM and RAM)', () => withCombo((b) => { const r = numberIn(bslot, { min: 1, max: 120, whole: true, what: 'the slot' }); if (r.value === null) return ctx.say(r.why || 'type a slot number, 1 to 120', 'error'); return ask({ op: 'button_set', buttons: b, slot: r.value }, null, showEntries); })),
         bt('button-clear', 'Clear', 'these buttons play nothing any more', () => withCombo((b) => ask({ op: 'button_clear', buttons: b }, null, showEntries)))),
       el('div', { class: 'row' },
         bt('button-press', 'Press', 'press them as the receiver would, until a motion starts', () => withCombo((b) => ask({ op: 'button_press', buttons: b }, `${b} pressed`))),
@@ -91,9 +91,12 @@ export function createTables(root, ctx) {
       el('td', { text: s.used ? (s.endless ? '∞' : s.calls ? 'calls' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
       el('td', {}, ...(s.used ? [
         bt('', '▶', 'play', () => ask({ op: 'motion_play', slot: s.slot }, `playing motion ${s.slot}`)),
-        bt('', '■', 'stop', () => ask({ op: 'motion_stop' }, 'motion stopped')),
+        bt('', '■', 'stop (every page may stop)', () => ask({ op: 'motion_stop' }, 'motion stopped'), ''),
         bt('', '✎', 'pull into the editor', () => ctx.edit(s.slot), ''),
-        bt('', '✕', 'erase (its bytes backed up first)', () => ask({ op: 'motion_erase', slot: s.slot }, null, (x) => { ctx.say(`motion ${s.slot} erased; its bytes are in ${x.backup}`); list(); })),
+        bt('', '✕', 'erase (asks first; its bytes backed up first)', () => {
+          if (!window.confirm(`Erase motion ${s.slot}${s.name ? ` (${s.name})` : ''} from the board? Its bytes are backed up first.`)) return ctx.say('erase cancelled');
+          return ask({ op: 'motion_erase', slot: s.slot }, null, (x) => { ctx.say(`motion ${s.slot} erased; its bytes are in ${x.backup}`); list(); });
+        }),
       ] : [])))));
     ctx.controls();
   }
@@ -117,10 +120,14 @@ export function createTables(root, ctx) {
     trims.replaceChildren(...r.trims.filter((t) => t.allocated).map((t) => {
       const n = el('input', { type: 'number', min: -30, max: 30, step: 0.1, value: t.degrees, 'data-joint': t.name, class: 'needs-control', 'aria-label': `${t.name} trim in degrees` });
       n.addEventListener('change', () => {
-        const v = Number(n.value);
-        if (!(v >= -30 && v <= 30)) { n.classList.add('beyond'); return ctx.say(`${t.name}: a trim is within ±30°`, 'error'); }
-        n.classList.remove('beyond');
-        ask({ op: 'trim_set', joints: { [t.name]: v } }, `${t.name} trim ${v}° (RAM)`);
+        const typed = numberIn(n, { min: -30, max: 30, what: `${t.name} trim`, unit: '°' });
+        if (typed.value === null) {
+          if (typed.why) return ctx.say(typed.why, 'error');
+          n.value = t.degrees;  // emptied: nothing changes, the board's trim back
+          return;
+        }
+        // read back at once: the row says what RAM and ROM hold now (never "in ROM" for a RAM change)
+        ask({ op: 'trim_set', joints: { [t.name]: typed.value } }, `${t.name} trim ${typed.value}° (RAM, not kept in ROM)`).then((ok) => { if (ok) readTrims(); });
       });
       return el('div', { class: 'trim' }, el('span', { text: t.name }), n,
         el('span', { class: 'small muted', text: t.rom_degrees === null ? 'ROM –' : t.rom_degrees === t.degrees ? 'in ROM' : `ROM ${t.rom_degrees}` }));
@@ -129,7 +136,12 @@ export function createTables(root, ctx) {
   }
   persist.addEventListener('click', async () => {
     const joints = {};
-    for (const n of trims.querySelectorAll('input[data-joint]')) joints[n.dataset.joint] = Number(n.value);
+    for (const n of trims.querySelectorAll('input[data-joint]')) {
+      // every box must hold a trim: one that does not stops the whole write (nothing is kept in ROM)
+      const r = numberIn(n, { min: -30, max: 30, what: `${n.dataset.joint} trim`, unit: '°' });
+      if (r.value === null) return ctx.say(`${r.why || `${n.dataset.joint} trim: the box is empty`}: nothing was written to ROM`, 'error');
+      joints[n.dataset.joint] = r.value;
+    }
     if (await ask({ op: 'trim_set', joints, persist: true }, 'trims kept in ROM (the board loads them at power-on)')) readTrims();
   });
 
@@ -167,6 +179,7 @@ export function createTables(root, ctx) {
     const r = await ask({ op: 'rom_restore_commit', force: romForce.checked });
     if (r) ctx.say(r.unchanged ? 'the ROM already was that image: nothing written'
       : `restored: ${r.pieces_written} pieces written; the ROM it replaced is in ${r.before}`);
+    if (r && !r.unchanged) { list(); readTrims(); readButtons(); }  // what the page shows is the new ROM's
   });
 
   paintPad();

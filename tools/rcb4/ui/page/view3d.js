@@ -67,7 +67,9 @@ export async function createView(box, hello, opts = {}) {
       const j = joints.get(m.joint);
       const a = angles[m.joint];
       const beyond = j && a !== undefined && a !== null && (a < j.lower - 0.05 || a > j.upper + 0.05);
-      m.material.color.setHex(beyond ? 0xd0342c : copy.color);
+      m.material.color.setHex(copy.unknown ? 0x9a9a9a : beyond ? 0xd0342c : copy.color);
+      m.material.transparent = !!copy.unknown || copy.opacity < 1;
+      m.material.opacity = copy.unknown ? 0.35 : copy.opacity;
       m.material.emissive?.setHex(m.joint && m.joint === selected ? 0x1b3f8a : 0x000000);
       void name;
     }
@@ -136,7 +138,16 @@ export async function createView(box, hello, opts = {}) {
     stats,
     canvas,
     /** The measured angles (joint → degrees; null: unknown). */
-    setMeasured(angles) { Object.assign(measured, angles); pose(solid, measured); },
+    setMeasured(angles) {
+      Object.assign(measured, angles);
+      // Unknown angles (the board does not answer) are drawn as nothing, never as 0°: a joint
+      // without one keeps its last pose, and the body is greyed out while any is unknown.
+      const known = Object.fromEntries(Object.entries(measured).filter(([, a]) => Number.isFinite(a)));
+      solid.unknown = Object.keys(known).length < Object.keys(measured).length;
+      pose(solid, { ...solid.last, ...known });
+      solid.last = { ...solid.last, ...known };
+      stats.unknown = solid.unknown;
+    },
     /** The ghost's angles (joint → degrees), or null to hide it. */
     setGhost(angles) {
       ghost.root.visible = !!angles;
@@ -182,5 +193,5 @@ function build(THREE, body, look) {
     links.get(j.parent).add(frame);
     if (!j.fixed) pivots.set(j.name, { pivot, axis: new THREE.Vector3(...j.axis).normalize() });
   }
-  return { root: links.get(body.root), pivots, meshes, color: look.color };
+  return { root: links.get(body.root), pivots, meshes, color: look.color, opacity: look.opacity };
 }
