@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
 # rcb4_ros as a kxr_controller user meets it, against a real ROS master: an actionlib client of
 # control_msgs/FollowJointTrajectory on /fullbody_controller/follow_joint_trajectory (success within
-# tolerance, INVALID_JOINTS and INVALID_GOAL with nothing moved, cancel and preemption holding the
-# joints, a ROM motion refusing the goal), kxr_controller's ServoOnOff, Stretch and
-# AdjustAngleVector, the joints parameter and robot_description; on a board of our own whose
-# servos never move, PATH_TOLERANCE_VIOLATED and an adjustment; a script written as a
-# kxr_controller user writes it, run unchanged.
+# tolerance, INVALID_JOINTS and INVALID_GOAL with nothing moved (a point due at once too), cancel and
+# preemption holding the joints, a ROM motion refusing the goal), kxr_controller's ServoOnOff
+# (a mimic joint's servo, unknown names left out), Stretch and AdjustAngleVector (a threshold that
+# looks like radians said), the joints parameter and robot_description; on a board of our own
+# whose servos never move, PATH_TOLERANCE_VIOLATED and an adjustment; a script written as a
+# kxr_controller user writes it, run unchanged. interrupts_test.py: a silent board, takeovers.
 #   actions_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR MESSAGES_DIR
 # SPDX-License-Identifier: BSL-1.0
 import json
@@ -123,12 +124,14 @@ try:
                           (goal([(20, 1.0)], joints=("left_knee", "left_knee")), Result.INVALID_JOINTS, "a joint twice"),
                           (goal([(140, 1.0)]), Result.INVALID_GOAL, "a point beyond the limit"),
                           (goal([(20, 1.0), (30, 0.5)]), Result.INVALID_GOAL, "times that go back"),
-                          (goal([(float("nan"), 1.0)]), Result.INVALID_GOAL, "NaN")):
+                          (goal([(float("nan"), 1.0)]), Result.INVALID_GOAL, "NaN"),
+                          (goal([(60, 0.0)]), Result.INVALID_GOAL, "a single point at time_from_start 0")):
         client.send_goal(g)
         client.wait_for_result(rospy.Duration(5))
         r = client.get_result()
         time.sleep(0.3)
-        check(client.get_state() == GoalStatus.ABORTED and r.error_code == code and abs(position("left_knee") + 10) < 0.5,
+        check(client.get_state() == GoalStatus.ABORTED and r.error_code == code and abs(position("left_knee") + 10) < 0.5
+              and ("due at once" in r.error_string or "time_from_start 0" not in what),
               f"{what}: {code}, nothing moves ({client.get_state()}, {r.error_code}: {r.error_string!r})")
 
     # Cancel mid-way: the joint holds where it is.
@@ -198,6 +201,12 @@ try:
     adjust.wait_for_result(rospy.Duration(5))
     check(adjust.get_state() == GoalStatus.SUCCEEDED and "no joint" in adjust.get_goal_status_text(),
           f"AdjustAngleVector with the joints on their way: nothing held ({adjust.get_goal_status_text()!r})")
+    # kxr_controller's client passes numpy.deg2rad(5): read as degrees (as its server does), and said.
+    adjust.send_goal(AdjustAngleVectorGoal(joint_names=["head_yaw"], error_threshold=[math.radians(5)]))
+    adjust.wait_for_result(rospy.Duration(5))
+    check(adjust.get_state() == GoalStatus.SUCCEEDED and "look like radians" in adjust.get_goal_status_text(),
+          f"AdjustAngleVector with a threshold of 0.087: a warning that it looks like radians "
+          f"({adjust.get_goal_status_text()!r})")
 
     # A script as a kxr_controller user writes it, unchanged.
     script = os.path.join(tempfile.mkdtemp(), "kxr_user.py")
@@ -244,11 +253,14 @@ try:
     client.send_goal(goal([(-60, 3.0)], joints=("right_knee",)))
     time.sleep(0.6)
     first_out = out = stop(node)
-    ended = client.wait_for_result(rospy.Duration(3))
+    # The final state, within a deadline: actionlib's client threads may still be taking the result
+    # (and may log "a goal handle that we're not tracking" for the goals before it).
+    ended = wait_for(lambda: client.get_state() == GoalStatus.ABORTED and "node stopped" in client.get_goal_status_text(),
+                     timeout=5)
     last = position("right_knee")
-    check(ended and client.get_state() == GoalStatus.ABORTED and "node stopped" in client.get_goal_status_text()
-          and "publish() to a closed topic" not in out,
-          f"SIGINT during a goal: ABORTED, said ({client.get_state()}, {client.get_goal_status_text()!r})")
+    check(ended and "publish() to a closed topic" not in out,
+          f"SIGINT during a goal: ABORTED, said ({client.get_state()}, {client.get_goal_status_text()!r}"
+          f"{''.join(', ' + l.strip()[-200:] for l in out.splitlines() if 'publish() to a closed topic' in l)})")
     knee = tool_joints(dev).get("right_knee", {}).get("degrees")
     check(knee is not None and abs(knee - last) < 3 and knee > -50,
           f"and right_knee holds where it was (the tool reads {knee}, the last joint_states {last:.1f}), not -60")
@@ -342,7 +354,29 @@ try:
     r = client.get_result()
     check(client.get_state() == GoalStatus.ABORTED and r.error_code == Result.INVALID_JOINTS and "follows L_FINGER" in r.error_string,
           f"a goal for the mimic joint: INVALID_JOINTS, saying what it follows ({r.error_string!r})")
-    check(not rospy.has_param("/robot_description"), "no kinematics: no robot_description (said in the log)")
+    # ServoOnOff on the mimic joint acts on the servo it shares; a name the node does not have is
+    # left out and said (as kxr_controller skips it), when another is known.
+    on_off = actionlib.SimpleActionClient("/fullbody_controller/servo_on_off_real_interface", ServoOnOffAction)
+    on_off.wait_for_server(rospy.Duration(5))
+    on_off.send_goal(ServoOnOffGoal(joint_names=["R_FINGER"], servo_on_states=[False]))
+    on_off.wait_for_result(rospy.Duration(5))
+    said = on_off.get_goal_status_text()
+    client.send_goal(goal([(10, 0.3)], joints=("L_FINGER",)))  # a freed joint is left out: it stays
+    client.wait_for_result(rospy.Duration(5))
+    time.sleep(0.3)
+    check(on_off.get_state() == GoalStatus.SUCCEEDED and "free: 1 joints" in said and abs(position("L_FINGER") - 30) < 1,
+          f"ServoOnOff off for the mimic R_FINGER frees the servo it shares: L_FINGER stays at "
+          f"{position('L_FINGER'):.1f}, not 10 ({said!r})")
+    on_off.send_goal(ServoOnOffGoal(joint_names=["L_FINGER", "L_WHEEL"], servo_on_states=[True, True]))
+    on_off.wait_for_result(rospy.Duration(5))
+    said = on_off.get_goal_status_text()
+    client.send_goal(goal([(10, 0.3)], joints=("L_FINGER",)))
+    client.wait_for_result(rospy.Duration(5))
+    time.sleep(0.3)
+    check(on_off.get_state() == GoalStatus.SUCCEEDED and "L_WHEEL" in said and "left out" in said
+          and abs(position("L_FINGER") - 10) < 1,
+          f"ServoOnOff naming a joint the node does not have, with one it has: that one left out, said, the "
+          f"other on ({said!r}; L_FINGER {position('L_FINGER'):.1f})")
 finally:
     out = stop(node)
     srv.terminate()

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 # The rcb4 ROS node against a real ROS master (rosmaster --core on a free port): joint_states at
 # the asked rate with every joint, a trajectory that moves left_knee (checked through the rcb4 tool
-# once the node has let the board go), a point beyond a limit that moves nothing, free and hold,
+# once the node has let the board go), a point beyond a limit or due at once that moves nothing,
+# stop and ~stop holding where the joint is, free and hold,
 # SIGINT within 1 s; then on a board of our own that falls silent: diagnostics ERROR and no stale
 # joint_states until it answers again.
 #   node_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR
@@ -97,6 +98,10 @@ try:
     trajectory([(140, 0.5)])
     time.sleep(1.0)
     check(abs(last_position("left_knee") - 35) < 0.5, f"a point beyond the limit moves nothing ({last_position('left_knee')})")
+    trajectory([(60, 0.0)])  # due at once: a jump at full servo speed; refused, as ROS 1's JTC does
+    time.sleep(0.5)
+    check(abs(last_position("left_knee") - 35) < 0.5,
+          f"a single point at time_from_start 0 moves nothing ({last_position('left_knee')})")
 
     # A streamed command for one joint leaves another on its way: head_yaw's 2 s move goes on.
     t = JointTrajectory()
@@ -201,6 +206,7 @@ try:
     check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
     check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
     check("motion 3 is running on the board" in out, "the trajectory refused under motion 3 is logged")
+    check("every point is due at once" in out, "the trajectory whose point is due at once is logged")
     check("no joint is called 'no_such_joint'" in out and out.count("beyond its upper limit 130") >= 2,
           "two different refusals in a row are each logged")
     check("what was under way for left_knee is dropped" in out and "left_knee is free: left out" in out,

@@ -1,7 +1,9 @@
 # rcb4_ros: a ROS 1 node for KONDO's RCB-4 (KHR-3HV, KXR) over pyrcb4. One thread owns the line:
-# callbacks only check what they are given and queue it; the loop reads the joints once per
-# cycle, publishes them, and carries out what was queued. Standard messages only; SI units.
+# callbacks only check what they are given and queue it; the loop sends the holds asked first
+# (holds.py), reads the joints once per cycle, publishes them, and carries out what was queued.
+# Standard messages only; SI units.
 # SPDX-License-Identifier: BSL-1.0
+import collections
 import json
 import math
 import queue
@@ -19,10 +21,11 @@ from trajectory_msgs.msg import JointTrajectory
 
 import pyrcb4
 from rcb4_ros import actions
+from rcb4_ros.holds import Holds
 from rcb4_ros.requests import Requests
 from rcb4_ros.trajectory import Trajectories
 
-class Rcb4Node(Trajectories, Requests):
+class Rcb4Node(Trajectories, Requests, Holds):
     """The node: parameters ~device (empty: the in-process virtual board), ~baud, ~robot, ~rate
     (default: one cycle per board output period), ~joint_prefix, ~timeout."""
 
@@ -62,16 +65,17 @@ class Rcb4Node(Trajectories, Requests):
         self.loop = self.board.control_loop()
         self.angles = numpy.full(len(self.names), numpy.nan)
         self.requests = queue.Queue()  # (what, argument, reply) for the loop thread
-        self.lock = threading.Lock()   # guards the trajectory and the streamed target
+        self.lock = threading.RLock()  # guards the trajectory, the streamed target and the holds asked
         self.trajectory = []           # [(due monotonic time, targets in degrees, frames)], next first
         self.stream = None             # (targets in degrees, received) from ~joint_command
         self.freed = numpy.zeros(len(self.names), dtype=bool)  # freed joints: no command powers them again
         self.read_freed()
-        self.halt = False              # stop: every joint under way holds where it is, at the next cycle
         self.generation = 0            # counts what replaced the trajectory (a new one, a stop): actions watch it
-        self.replaced_by = ""          # why the last trajectory ended early
-        self.replacing = set()         # the joints (indices) the command that replaced it names
+        # What ended each trajectory early, by generation (replaced()): why, the hold asked with it,
+        # whether a goal under way fails, and the joints (indices) the command that replaced it names.
+        self.replacements = collections.deque(maxlen=32)
         self.moves = {}                # joint index -> (t0, from, to, t1) degrees: the move the board makes now
+        self.init_holds()              # holds asked and not yet taken by the board (holds.py)
         self.refused_at = {}           # refusal text -> when it was last logged (repeats once a second)
         self.link_ok, self.link_reason = True, ""
         self.cycles, self.errors, self.timeouts = 0, 0, 0
@@ -91,7 +95,7 @@ class Rcb4Node(Trajectories, Requests):
         rospy.Service("~free", Trigger, lambda r: self.trigger("free", ""))
         rospy.Service("~hold", Trigger, lambda r: self.trigger("hold", ""))
         rospy.Service("~stop_motion", Trigger, lambda r: self.trigger("stop", None))
-        rospy.Service("~stop", Trigger, lambda r: self.trigger("halt", None))
+        rospy.Service("~stop", Trigger, lambda r: self.stop_service())
         rospy.Service("~resume_motion", Trigger, lambda r: self.trigger("resume", None))
         rospy.loginfo("rcb4: %s, %d joints, %g Hz (output period %.0f ms)", self.where, len(self.names),
                       self.rate, self.period * 1000)
@@ -125,8 +129,10 @@ class Rcb4Node(Trajectories, Requests):
         return name[len(self.prefix):] if self.prefix and name.startswith(self.prefix) else name
 
     def cycle(self):
-        self.carry_out()
-        self.write_due()
+        self.send_holds()  # first: a stop, cancel or abort asked while the board was silent, as soon as it answers
+        if self.link_ok:   # a board that was silent is read first: nothing is asked of it before it answers
+            self.carry_out()
+            self.write_due()
         self.loop.read(out=self.angles)
         stamp = rospy.Time.now()
         msg = JointState()
@@ -182,6 +188,18 @@ class Rcb4Node(Trajectories, Requests):
         self.reopen_at = None
         rospy.loginfo("rcb4: %s opened again", self.device)
 
+    def drop_asked(self, why, hold=0):
+        """Drops what is under way and what was asked, said to whoever waits (an action goal, a service
+        caller) and logged; @p hold: the hold asked for the joints the board may still be moving."""
+        with self.lock:
+            pending = bool(self.trajectory) or self.stream is not None
+            self.trajectory, self.stream = [], None
+            if pending or hold:
+                self.replaced(f"{why}: what was under way is dropped", hold, failed=True)
+        if pending:
+            self.refuse(f"a command was dropped: {why}")
+        self.drop_requests(why)
+
     def diagnostics(self):
         now = time.monotonic()
         since, count = self.rate_window
@@ -218,6 +236,7 @@ class Rcb4Node(Trajectories, Requests):
                     self.cycle()
                     if not self.link_ok:
                         rospy.loginfo("rcb4: the board answers again")
+                        self.drop_asked(f"asked while the board did not answer ({self.link_reason})")
                     self.link_ok = True
                     if time.monotonic() - last_slow >= 0.2:  # 5 Hz, on a grid: no drift
                         self.slow_things()
@@ -230,23 +249,19 @@ class Rcb4Node(Trajectories, Requests):
                     self.errors += 1
                     if isinstance(e, pyrcb4.Timeout):
                         self.timeouts += 1
-                    if self.link_ok:
+                    went = self.link_ok
+                    if went:
                         rospy.logerr("rcb4: %s", e)
                     self.link_ok, self.link_reason = False, str(e)
                     self.angles[:] = numpy.nan
-                    # What is under way (or comes in) while the board is silent is dropped, and
-                    # said: it must not run late, all at once, when the board answers again.
-                    with self.lock:
-                        pending = bool(self.trajectory) or self.stream is not None
-                        self.trajectory, self.stream = [], None
-                        if pending:
-                            self.generation += 1
-                            self.replaced_by = f"dropped: the board does not answer ({e})"
-                    if pending:
-                        self.refuse(f"a command was dropped: the board does not answer ({e})")
-                    self.drop_requests(str(e))
+                    # What the board may still be moving holds as soon as it answers again (it must
+                    # not run on to the end of its segment); what is under way (or comes in) while it
+                    # is silent is dropped, and said: it must not run late, all at once, either.
+                    self.drop_asked(f"the board does not answer ({e})", self.hold_under_way() if went else 0)
+                    self.writing = None
+                    self.holds_not_sent()
                 if self.released:
-                    self.drop_requests(self.link_reason)
+                    self.drop_requests(f"the board does not answer ({self.link_reason})")
                 if self.reopen_at is not None and time.monotonic() >= self.reopen_at:
                     self.reopen()
                 if time.monotonic() - last_diag >= 1.0:
@@ -260,14 +275,17 @@ class Rcb4Node(Trajectories, Requests):
         finally:
             # An action goal under way ends (aborted, said to its client) and every joint holds
             # where it is before the board is let go: nothing runs on after the node.
-            self.stop_now("the node stopped (SIGINT/SIGTERM): the joints hold where they are")
+            self.stop_now("the node stopped (SIGINT/SIGTERM)", failed=True)
             if not self.released:
                 try:
-                    self.halt_now()
-                except pyrcb4.Error:
-                    pass
+                    self.send_holds()
+                except pyrcb4.Error as e:
+                    rospy.logerr("rcb4: the joints could not be held before the node stops (%s): the board runs "
+                                 "what it was moving to its end", e)
+                    self.holds_not_sent()
             if self.actions:
                 self.actions.wait_idle(1.0)
+                self.actions.quiet()
             if not self.released:
                 self.board.close()
 

@@ -1,6 +1,7 @@
 # rcb4_ros: what the node is asked to do on the board (a mixin of Rcb4Node, node.py): services and
 # topics queue a request; the loop thread carries it out between two cycles and answers; what is
 # asked while the board does not answer is dropped and answered as failed (it must never run later).
+# A stop is not a request: it is a hold that stays pending until the board takes it (holds.py).
 # SPDX-License-Identifier: BSL-1.0
 import queue
 import threading
@@ -37,6 +38,15 @@ class Requests:
     def trigger(self, what, argument):
         return TriggerResponse(*self.ask(what, argument))
 
+    def stop_service(self):
+        """~stop: what is under way is dropped and every joint holds where it is; answered once the board
+        has taken the hold, or (not a success) that it will be held as soon as the board answers."""
+        ok, why = self.hold_outcome(self.stop_now())
+        if ok:
+            return TriggerResponse(True, "stopped: every joint holds where it is")
+        return TriggerResponse(False, f"stopped, but the board did not answer{why}: every joint will hold where it "
+                                      "is as soon as it does")
+
     def carry_out(self):
         while True:
             try:
@@ -48,14 +58,7 @@ class Requests:
                 rospy.logwarn("rcb4: %s: dropped, its caller gave up waiting (the board did not answer)", what)
                 continue
             try:
-                if what == "hold_some":
-                    names = [self.names[i] for i in argument if not self.freed[i]]
-                    if names:
-                        self.board.hold(*names)
-                    for i in argument:
-                        self.moves.pop(i, None)
-                    message = f"held {len(names)} joints"
-                elif what in ("free", "hold"):
+                if what in ("free", "hold"):
                     names = [n[len(self.prefix):] if n.startswith(self.prefix) else n
                              for n in (argument or "").replace(",", " ").split()]
                     done = (self.board.free if what == "free" else self.board.hold)(*names)
@@ -69,9 +72,6 @@ class Requests:
                     if what == "free" and dropped:
                         message += f" (what was under way for {', '.join(dropped)} is dropped)"
                         rospy.logwarn("rcb4: %s", message)
-                elif what == "halt":
-                    self.stop_now()
-                    message = "stopped: every joint holds where it is"
                 elif what == "resume":
                     self.board.resume_motion()
                     message = "the ROM program runs again"
@@ -117,7 +117,7 @@ class Requests:
                 what, _, reply = self.requests.get_nowait()
             except queue.Empty:
                 return
-            rospy.logwarn("rcb4: %s: dropped, the board does not answer (%s)", what, why)
+            rospy.logwarn("rcb4: %s: dropped, %s", what, why)
             if reply:
-                reply[1].update(ok=False, message=f"{what}: the board does not answer ({why}): nothing was done")
+                reply[1].update(ok=False, message=f"{what}: {why}: nothing was done")
                 reply[0].set()

@@ -1,8 +1,8 @@
 # rcb4_ros: the node's trajectory engine (a mixin of Rcb4Node, node.py). The callbacks check a
 # goal (every joint named once, inside its limits) and hand it over under the lock; the loop
 # thread follows it: each cycle it writes the segment due (the board interpolates between the
-# points), adjusts for joints that lag, and holds what was under way when a stop, a newer goal
-# or another command takes over.
+# points) and adjusts for joints that lag; a stop asks that every joint hold where it is
+# (holds.py: sent first in the next cycle, or as soon as a silent board answers again).
 # SPDX-License-Identifier: BSL-1.0
 import math
 import time
@@ -11,6 +11,16 @@ import numpy
 import rospy
 
 import pyrcb4
+
+
+def due_at_once(last, period):
+    """Why a trajectory whose last point is at time_from_start @p last (s) is refused, or None:
+    every point due within one output period would be a jump at the servos' full speed (ROS 1's
+    joint_trajectory_controller drops the points due before its next update and refuses the goal)."""
+    if last >= period:
+        return None
+    return (f"every point is due at once (the last at time_from_start {last:.3f} s, within one output period "
+            f"of {period * 1000:.0f} ms): the joints would jump at full servo speed; give the points their times")
 
 
 class Trajectories:
@@ -40,14 +50,28 @@ class Trajectories:
             targets[i] = deg
         return targets
 
-    def stop_now(self, why="stopped (~stop, an empty trajectory or a cancel): the joints hold where they are"):
-        """Stop: what is under way is dropped and every joint that moves holds where it is now."""
+    def stop_now(self, why="stopped (~stop, an empty trajectory or a cancel)", failed=False):
+        """Stop: what is under way is dropped and every joint holds where it is (HOLD: the board ends its
+        interpolation there), at the next cycle or as soon as a silent board answers again. Returns the
+        hold request, for wait_hold."""
         with self.lock:
             self.trajectory = []
             self.stream = None
-            self.halt = True
-            self.generation += 1
-            self.replaced_by = why
+            token = self.ask_hold()
+            self.replaced(why, token, failed)
+            return token
+
+    def replaced(self, why, hold=0, failed=False, replacing=()):
+        """Says (under the lock) that what was under way ended early: @p why, the hold request asked with
+        it (holds.py), whether a goal under way fails (aborted) rather than gives way (preempted), and
+        the joints (indices) the new command names. Actions watch the generation."""
+        self.generation += 1
+        self.replacements.append((self.generation, why, hold, failed, set(replacing)))
+
+    def replacement(self, generation):
+        """What ended generation @p generation (why, hold, failed, replacing): the first one after it."""
+        with self.lock:
+            return next((r[1:] for r in self.replacements if r[0] > generation), ("replaced", 0, False, set()))
 
     def move_refusal(self):
         """Why a move would fight a ROM motion now (the one rule, through pyrcb4), or None."""
@@ -65,13 +89,15 @@ class Trajectories:
                 raise ValueError(f"point {k}: its time goes back ({t:.3f} s after {last:.3f} s)")
             moves += self.segment(last, t, before, targets)
             before, last = targets, t
+        at_once = due_at_once(last, self.period) if points else None
+        if at_once:
+            raise ValueError(at_once)
         begin = time.monotonic() + max(0.0, stamp - rospy.get_time()) if stamp else time.monotonic()
         with self.lock:  # a newer trajectory replaces what is left of the old one
             self.trajectory = [(begin + at, targets, frames) for at, targets, frames in moves]
             self.stream = None
-            self.generation += 1
-            self.replaced_by = "replaced by a newer trajectory or command"
-            self.replacing = {i for _, t, _ in self.trajectory for i in numpy.flatnonzero(~numpy.isnan(t))}
+            self.replaced("replaced by a newer trajectory or command",
+                          replacing={int(i) for _, t, _ in self.trajectory for i in numpy.flatnonzero(~numpy.isnan(t))})
             return self.generation
 
     def on_trajectory(self, msg):
@@ -108,9 +134,8 @@ class Trajectories:
             return
         with self.lock:
             self.stream = targets
-            self.generation += 1
-            self.replaced_by = "replaced by a joint_command"
-            self.replacing = set(int(i) for i in numpy.flatnonzero(~numpy.isnan(targets)))
+            self.replaced("replaced by a joint_command",
+                          replacing={int(i) for i in numpy.flatnonzero(~numpy.isnan(targets))})
             # The joints it names leave the trajectory under way; the others go on with it.
             named = ~numpy.isnan(targets)
             rest = []
@@ -167,13 +192,6 @@ class Trajectories:
                     self.stream = None
         return [self.prefix + self.names[i] for i in sorted(busy)]
 
-    def halt_now(self):
-        """Every joint that is held holds where it is now (HOLD: the board stops its interpolation there)."""
-        held = [n for n, f in zip(self.names, self.freed) if not f]
-        if held:
-            self.board.hold(*held)
-        self.moves.clear()
-
     def without_freed(self, targets, what):
         """@p targets with the freed joints left out (a position would power them again), said once."""
         named = ~numpy.isnan(targets) & self.freed
@@ -187,11 +205,6 @@ class Trajectories:
     def write_due(self):
         now = time.monotonic()
         with self.lock:
-            halt, self.halt = self.halt, False
-        if halt:
-            self.halt_now()
-            return
-        with self.lock:
             due = None
             while self.trajectory and self.trajectory[0][0] <= now:
                 due = self.trajectory.pop(0)
@@ -203,8 +216,7 @@ class Trajectories:
             self.refuse(f"{refusal} (~stop_motion first)")
             with self.lock:
                 self.trajectory = []
-                self.generation += 1
-                self.replaced_by = f"{refusal} (~stop_motion first)"
+                self.replaced(f"{refusal} (~stop_motion first)")
             return
         if due:
             due = (due[0], self.without_freed(due[1], "trajectory"), due[2])
@@ -227,15 +239,17 @@ class Trajectories:
     def write(self, targets, frames, now):
         """Sends a move; one the board refuses (a joint with no servo on it) is dropped and said, with
         what was under way: it is not the link failing."""
+        self.writing = targets  # until the board answers: one that goes silent may take it late
         try:
             self.loop.write(targets, frames=frames)
         except pyrcb4.BoardRefused as e:
+            self.writing = None
             with self.lock:
                 self.trajectory, self.stream = [], None
-                self.generation += 1
-                self.replaced_by = f"dropped: {e}"
+                self.replaced(f"dropped: {e}", failed=True)
             self.refuse(f"a command was dropped: {e}")
             return
+        self.writing = None
         self.moved(targets, frames, now)
 
     def moved(self, targets, frames, now):
