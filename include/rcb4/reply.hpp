@@ -115,7 +115,14 @@ constexpr parse_result<reply> finish_reply(std::span<const std::uint8_t> frame, 
       return r;
     }
   } else {
-    r.value = reply::data(frame[1], frame.subspan(2, frame.size() - 3)).value();
+    // A data frame carries 1-252 bytes (protocol.md §2.2): a 3-byte frame carries none and is
+    // refused here, never trapped on (a parser on a serial line must not trap on any input).
+    const auto d = reply::data(frame[1], frame.subspan(2, frame.size() - 3));
+    if (!d) {
+      r.error = errc::frame_too_short;
+      return r;
+    }
+    r.value = d.value();
   }
   r.status = parse_status::complete;
   return r;
@@ -133,6 +140,13 @@ constexpr parse_result<reply> finish_reply(std::span<const std::uint8_t> frame, 
  */
 constexpr parse_result<reply> parse_reply(std::span<const std::uint8_t> in, reply_shape expected) noexcept {
   parse_result<reply> r;
+  // A shape no board can answer (data of 0 bytes, or more than 252): refused, whatever came in.
+  if (expected.data && (expected.data_size == 0 || expected.data_size > max_reply_data)) {
+    r.status = parse_status::error;
+    r.error = errc::bad_reply_length;
+    r.consumed = in.size();
+    return r;
+  }
   const std::size_t want = expected.frame_size();
   if (in.empty()) {
     r.needed = ack_frame_size;  // every reply is at least 4 bytes

@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <numeric>
 #include <vector>
 
@@ -75,6 +76,24 @@ TEST_CASE("host-side reply errors name what was wrong", "[reply][errors]") {
   CHECK(parse_reply(std::span<const std::uint8_t>{}, ack_ping).needed == 4);
   const std::uint8_t short_frame[] = {0x03, 0xFE, 0x01};
   CHECK(parse_reply_frame(short_frame).error == errc::frame_too_short);
+}
+
+TEST_CASE("a reply shape no board can answer is refused, never trapped on", "[reply][errors]") {
+  // reply_shape is a public aggregate: {cmd, data, 0} and sizes above 252 can be built by anyone.
+  // The frame 03 00 03 (well-formed: its sum is right) trapped in parse_reply (review R3).
+  const std::uint8_t three[] = {0x03, 0x00, 0x03};
+  for (const std::uint8_t n : {std::uint8_t{0}, std::uint8_t{253}, std::uint8_t{255}}) {
+    INFO(int(n));
+    const reply_shape shape{0x00, true, n};
+    const auto r = parse_reply(three, shape);
+    CHECK(r.status == parse_status::error);
+    CHECK(r.error == errc::bad_reply_length);
+    CHECK(r.consumed == 3);
+    CHECK(parse_reply(std::span<const std::uint8_t>{}, shape).status == parse_status::error);
+  }
+  // and compile time says the same
+  static_assert(parse_reply(std::array<std::uint8_t, 3>{0x03, 0x00, 0x03}, reply_shape{0x00, true, 0}).error ==
+                errc::bad_reply_length);
 }
 
 TEST_CASE("board-side replies", "[reply]") {
