@@ -75,11 +75,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const bool controlled = c.controlling() == from;
     const auto e = c.receive(from, all.substr(start, end - start), now);
     check_letters(e);
-    // A page that did not control when it spoke causes no action but a reading one (or taking control).
+    // A page that did not control when it spoke causes no action but a reading one, or a stop
+    // (every page keeps Stop: it only ever holds the joints and stops a motion).
     if (!controlled)
       for (const auto& a : e.actions) {
         const auto* st = std::get_if<studio_action>(&a.body);
         check(std::holds_alternative<refresh_action>(a.body) || std::holds_alternative<motion_file_action>(a.body) ||
+              std::holds_alternative<stop_action>(a.body) || std::holds_alternative<motion_stop_action>(a.body) ||
               (st && studio_reads(st->op)));
       }
     now += std::chrono::milliseconds(10);

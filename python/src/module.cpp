@@ -71,9 +71,9 @@ py::dict status_dict(const motion_status& s) {
 }
 
 /** The slot names kept for @p b's robot (a names file that does not read: UsageError). */
-std::map<unsigned, std::string> load_names(const board& b) {
+std::map<unsigned, rcb4::robot::services::slot_label> load_names(const board& b) {
   try {
-    return rcb4::robot::services::load_slot_names(b.robot().name());
+    return rcb4::robot::services::load_slot_labels(b.robot().name());
   } catch (const rcb4::robot::services::refused& e) {
     throw board_error(fault::usage, e.what());
   }
@@ -383,7 +383,7 @@ file. timeout: seconds each exchange may take. Use it as a context manager, or c
             for (std::size_t i = 0; i < v.size(); ++i) {
               const auto& s = v[i];
               const auto& state = states[i];
-              const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names);
+              const auto name = rcb4::robot::services::slot_name(b.robot(), s.number, names, s.code);
               // Its seconds as the board plays it (loops counted, no button held), where the steps express it.
               py::object seconds = py::none();
               if (const auto& t = state.plays) {

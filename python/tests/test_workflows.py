@@ -174,6 +174,26 @@ def test_terminal_settings_changed_by_another_program(served):
                     raise
 
 
+def test_a_slot_name_belongs_to_the_code_not_to_the_slot_number(board):
+    # Two boards of one robot model share the names file (issue 41, H5): another board's push to
+    # slot 14 must never rename this board's slot 14, which holds other code.
+    other = pyrcb4.Board()
+    try:
+        board.push_motion({"name": "wave", "steps": [{"pose": {"head_yaw": 20}, "time_ms": 200}, "end"]}, 14,
+                          backup="14a.bin")
+        other.push_motion({"name": "bow", "steps": [{"pose": {"left_knee": 30}, "time_ms": 300}, "end"]}, 14,
+                          backup="14b.bin")
+        assert {m["slot"]: m["name"] for m in other.motions()}[14] == "bow"
+        assert {m["slot"]: m["name"] for m in board.motions()}[14] is None  # not "bow": its code is not bow's
+        assert board.pull_motion(14).get("name") in (None, "")
+        # the same code on both boards: the name shows on both
+        other.push_motion({"name": "wave", "steps": [{"pose": {"head_yaw": 20}, "time_ms": 200}, "end"]}, 14,
+                          backup="14c.bin")
+        assert {m["slot"]: m["name"] for m in board.motions()}[14] == "wave"
+    finally:
+        other.close()
+
+
 def test_slot_names_kept_with_the_code(board):
     r = board.push_motion({"name": "wave", "steps": [{"pose": {"head_yaw": 20}, "time_ms": 200}, "end"]}, 14,
                           backup="14.bin")

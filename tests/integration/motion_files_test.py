@@ -377,6 +377,15 @@ with serve("--rom", rom_file, "--period", "15") as dev:
     os.remove("damaged.bin.crc32")
     rc, out, err = run(*on, "--timeout", "1000", "rom", "restore", "damaged.bin")
     check(rc == 2 and ".crc32 is missing" in err, f"no .crc32: exit 2 unless --no-check ({rc}: {err.strip()!r})")
+    # rcb4 ui's one-file backup: the CRC-32 in the file's name (issue 41, M7), no .crc32 beside it.
+    named = "rcb4-rom-20261128-101010-crc32-%08x.bin" % zlib.crc32(image)
+    open(named, "wb").write(image)
+    rc, out, err = run(*on, "--timeout", "1000", "rom", "restore", named)
+    check(rc == 0 and "nothing written" in out, f"a CRC in the file's name checks it ({rc}: {out.strip()!r} {err.strip()!r})")
+    wrong = "rcb4-rom-20261128-101010-crc32-%08x.bin" % (zlib.crc32(image) ^ 1)
+    open(wrong, "wb").write(image)
+    rc, out, err = run(*on, "--timeout", "1000", "rom", "restore", wrong)
+    check(rc == 2 and "the file changed or is damaged" in err, f"and a name whose CRC differs: exit 2 ({rc}: {err.strip()!r})")
 
 # The served ROM is saved when it changes, not only at a clean exit.
 rom2 = os.path.join(work, "hup.rom")

@@ -339,6 +339,28 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
             said = wait_until(lambda: ("restore" in message(driver).lower() or "image" in message(driver)
                                        or "boot" in message(driver)) and message(driver), timeout=30)
             check(said and want in said, f"restore of {os.path.basename(path)} through the page: {said!r}")
+        # Erase asks first (declined: nothing erased); accepted, its bytes are backed up, and that
+        # .bin goes back into the slot through Open… (issue 41, M8).
+        click(driver, "id", "slots-refresh")
+        row10 = lambda: js(driver, "const r = document.querySelector('#slots tr[data-slot=\"10\"]'); return r ? r.textContent : ''")  # noqa: E731
+        wait_until(lambda: "free" not in row10(), timeout=10)
+        js(driver, "window.savedConfirm = window.confirm; window.confirm = () => false")
+        click(driver, "css", '#slots tr[data-slot="10"] button[title^="erase"]')
+        check(wait_until(lambda: "erase cancelled" in message(driver), timeout=5) and "free" not in row10(),
+              f"erase asks first; declined, the slot stays ({row10()!r})")
+        js(driver, "window.confirm = () => true")
+        click(driver, "css", '#slots tr[data-slot="10"] button[title^="erase"]')
+        said = wait_until(lambda: "erased; its bytes are in" in message(driver) and message(driver), timeout=10)
+        kept = said.split("its bytes are in ")[-1].strip() if said else ""
+        check(os.path.exists(kept) and wait_until(lambda: "free" in row10(), timeout=10),
+              f"accepted: erased, its bytes kept ({said!r})")
+        js(driver, "document.querySelector('#ed-slot').value = 10; document.querySelector('#ed-file').hidden = false")
+        driver.find_element(By.ID, "ed-file").send_keys(kept)
+        back = wait_until(lambda: "is back in slot 10" in message(driver) and message(driver), timeout=20)
+        click(driver, "id", "slots-refresh")
+        check(back and wait_until(lambda: "free" not in row10(), timeout=10),
+              f"its .bin opened in the editor goes back into slot 10 ({back!r}, {row10()!r})")
+        js(driver, "window.confirm = window.savedConfirm; document.querySelector('#ed-file').hidden = true")
         # A second page watching is told why its controls are off.
         second = browser()
         try:

@@ -23,7 +23,8 @@ std::string target_text(std::uint32_t a, const rcb4::rom_layout& layout, const r
   if (a >= layout.motion_base.value() && (a - layout.motion_base.value()) % layout.slot_size == 0) {
     const auto k = (a - layout.motion_base.value()) / layout.slot_size + 1;
     if (k <= layout.motion_count) {
-      const auto name = rcb4::robot::services::slot_name(robot, k);
+      // the profile's name only: a name of the names file is shown where the slot's code is read (motion list)
+      const auto name = rcb4::robot::services::slot_name(robot, k, {});
       return fmt::format("motion {}{} (0x{:06X})", k, name.empty() ? "" : fmt::format(" \"{}\"", name), a);
     }
   }

@@ -179,7 +179,7 @@ int show_motion(session& s, int n, const motion_options& o, const globals& g) {
   const auto l = m::disassemble(bytes, *where);
   const auto lifted = empty ? m::outcome<m::program>{m::failure{"the slot is empty"}} : m::lift(l);
   json code = json::array();
-  const auto motion_name = rcb4::robot::services::slot_name(robot, static_cast<unsigned>(n));
+  const auto motion_name = rcb4::robot::services::slot_name(robot, static_cast<unsigned>(n), bytes);
   if (!g.json)
     fmt::print("motion {}{} at 0x{:06X} ({} layout, slot of {} bytes){}\n", n,
                motion_name.empty() ? std::string() : fmt::format(" ({})", motion_name), where->address.value(),
@@ -377,12 +377,12 @@ void add_motion_commands(CLI::App& app, context& ctx) {
       fmt::print("{:>4}  {:<20} {:>8}  {:>6}  {:>8}  {:>8}  {}\n", "slot", "name", "address", "bytes", "commands",
                  "seconds", "");
     const auto period = s.run(rcb4::ops::read_config{}).period;
-    const auto names = rcb4::robot::services::load_slot_names(m.name());
+    const auto names = rcb4::robot::services::load_slot_labels(m.name());
     const auto states = rcb4::robot::services::slot_states(op.value(), layout);
     for (std::size_t i = 0; i < op.value().size(); ++i) {
       const auto& v = op.value()[i];
       const auto& state = states[i];
-      const auto name = rcb4::robot::services::slot_name(m, v.number, names);
+      const auto name = rcb4::robot::services::slot_name(m, v.number, names, v.code);
       // Its time as the board plays it (loops counted); one that calls others plays for as long as
       // they do too: not counted here ("calls").
       const auto& plays = state.plays;

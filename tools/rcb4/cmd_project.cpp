@@ -292,7 +292,7 @@ int flow_push(session& s, const flow_options& o, const globals& g) {
   const auto r = sv::push_motion(
       link, robot_of(g), layout, n, src,
       [&](unsigned motion, std::span<const std::uint8_t> old) { return sv::save_backup_file(motion, old, o.backup); });
-  sv::set_slot_name(robot_of(g).name(), n, std::filesystem::path(o.file).stem().string());
+  sv::set_slot_name(robot_of(g).name(), n, std::filesystem::path(o.file).stem().string(), r.fingerprint);
   if (g.json) {
     emit(json{{"file", o.file},
               {"pushed", n},

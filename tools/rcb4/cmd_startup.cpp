@@ -19,7 +19,8 @@ int startup(session& s, const motion_options& m, const std::string& which, const
   const auto& layout = layout_for(s, m);
   session_link link(s, g.json);
   const auto r = set ? sv::set_startup(link, layout, n) : sv::read_startup(link, layout);
-  const auto name = r.motion ? sv::slot_name(robot_of(g), *r.motion) : std::string();
+  // the profile's name only: a name of the names file is shown where the slot's code is read (motion list)
+  const auto name = r.motion ? sv::slot_name(robot_of(g), *r.motion, {}) : std::string();
   if (g.json) {
     emit(json{{"call", r.has_call},
               {"target", r.has_call ? json(r.target) : json(nullptr)},

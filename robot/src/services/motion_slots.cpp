@@ -196,12 +196,16 @@ push_report push_motion(link& l, const model& robot, const rom_layout& layout, u
     r.backup = backup(n, old);
     write_rom_checked(l, r.address, r.bytes, fmt::format("writing motion {}", n), n, r.backup);
   }
+  // The slot as a listing reads it now: the new bytes over the old (the fingerprint its name keeps).
+  auto after = old;
+  std::copy(r.bytes.begin(), r.bytes.end(), after.begin());
+  r.fingerprint = code_fingerprint(after);
   // A motion file names its slot (the board keeps no names): the name goes with the code, and a
-  // file without one leaves the slot unnamed. A backup's bytes keep whatever name the slot had.
+  // file without one leaves the slot unnamed. A backup's bytes show the name given with that code, if any.
   if (src.document) {
     r.name = src.document->name;
     try {
-      set_slot_name(robot.name(), n, r.name);
+      set_slot_name(robot.name(), n, r.name, r.fingerprint);
     } catch (const refused& e) {
       r.notes.push_back(fmt::format("the slot's name was not kept: {}", e.what()));
     }
@@ -216,7 +220,7 @@ erase_report erase_motion(link& l, const rom_layout& layout, unsigned n, const b
   const auto forget = [&] {
     if (robot.empty()) return;
     try {
-      set_slot_name(robot, n, {});
+      set_slot_name(robot, n, {}, std::nullopt);
     } catch (const refused&) {  // an unreadable names file: the erase itself is done
     }
   };
@@ -270,7 +274,7 @@ pull_report pull_motion(link& l, const model& robot, const rom_layout& layout, u
   r.document = from_program(std::get<mo::program>(p), robot, layout, r.period);
   r.plays = play_time_text(mo::play_time(std::get<mo::program>(p)), r.period);
   try {
-    r.document.name = slot_name(robot, n, load_slot_names(robot.name()));
+    r.document.name = slot_name(robot, n, load_slot_labels(robot.name()), bytes);
   } catch (const refused&) {  // an unreadable names file: the profile's name
     r.document.name = std::string(robot.motion(n));
   }

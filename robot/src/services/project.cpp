@@ -3,6 +3,7 @@
 #include <rcb4/ops/memory.hpp>
 #include <rcb4/ops/motion.hpp>
 #include <rcb4/ops/system.hpp>
+#include <rcb4/robot/services/motion_slots.hpp>
 #include <rcb4/robot/services/project.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
@@ -70,7 +71,9 @@ project_import_report import_project(link& l, const rom_layout& layout, const mo
     if (m.frames.empty()) continue;
     std::string name = m.name.substr(0, 64);
     if (name.find_first_of("\r\n") != std::string::npos) name.clear();
-    set_slot_name(robot.name(), m.number + 1, name);
+    const auto where = slot_for(layout, static_cast<long long>(m.number) + 1);
+    set_slot_name(robot.name(), m.number + 1, name,
+                  code_fingerprint(std::span(r.plan.image).subspan(where.address.value(), where.size)));
     r.names += !name.empty();
   }
   return r;
@@ -84,8 +87,12 @@ hth4::export_result export_project(link& l, const rom_layout& layout, const mode
   for (const auto& j : robot.joints())
     if (j.ics.value() < names.size()) names[j.ics.value()] = j.name;
   std::vector<std::string> slots(hth4::motion_count);
-  for (const auto& [n, name] : load_slot_names(robot.name()))
-    if (n >= 1 && n <= slots.size()) slots[n - 1] = name;
+  for (const auto& [n, label] : load_slot_labels(robot.name()))  // only a name given to the code each slot holds
+    if (n >= 1 && n <= slots.size()) {
+      const auto where = slot_for(layout, n);
+      if (label.code && *label.code == code_fingerprint(std::span(rom).subspan(where.address.value(), where.size)))
+        slots[n - 1] = label.name;
+    }
   const auto now = std::time(nullptr);
   std::tm tm{};
   localtime_r(&now, &tm);

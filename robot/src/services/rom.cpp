@@ -62,6 +62,16 @@ void save_rom_image(const std::string& path, std::span<const std::uint8_t> image
                   "name another place");
 }
 
+std::string crc_in_name(const std::string& path) {
+  const auto name = std::filesystem::path(path).stem().string();
+  const auto at = name.rfind("-crc32-");
+  if (at == std::string::npos || name.size() != at + 7 + 8) return {};
+  const auto hex = name.substr(at + 7);
+  for (const char c : hex)
+    if (!((c >= '0' && c <= '9') || (c >= 'a' && c <= 'f'))) return {};
+  return hex;
+}
+
 std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check) {
   std::error_code ec;
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
@@ -81,7 +91,10 @@ std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check)
                                                    path, image.size(), rom_size));
   std::ifstream sum(path + ".crc32");
   std::string word;
-  if (!(sum >> word)) {
+  // Without a .crc32 beside it, a CRC in the file's own name ("…-crc32-1a2b3c4d.bin", as rcb4 ui
+  // downloads a backup: one file, which no browser splits) is the check.
+  if (!(sum >> word)) word = crc_in_name(path);
+  if (word.empty()) {
     if (no_check) return image;
     throw refused(refusal_kind::usage, fmt::format("{}.crc32 is missing or empty: the image cannot be checked", path),
                   "rcb4 rom backup writes it beside the image; --no-check restores one without it (its plausibility "
@@ -90,7 +103,8 @@ std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check)
   const auto want = fmt::format("{:08x}", crc32(image));
   if (word != want)
     throw refused(refusal_kind::usage,
-                  fmt::format("{} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged", path, want, word),
+                  fmt::format("{} has CRC-32 {}, its .crc32 (or its name) says {}: the file changed or is damaged",
+                              path, want, word),
                   fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
                               "delete {}.crc32 and restore with --no-check",
                               path, path));

@@ -1,6 +1,8 @@
 // rcb4 — robot services: the names of a board's motion slots (see rcb4/robot/services/slot_names.hpp).
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/frame.hpp>
 #include <rcb4/robot/services/link.hpp>
+#include <rcb4/robot/services/rom.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
 
 #include <fmt/format.h>
@@ -8,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cerrno>
+#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -45,8 +48,24 @@ std::string slot_names_file() {
   return (fs::path(home && *home ? home : ".") / ".config" / "rcb4" / "slot-names.yaml").string();
 }
 
-std::map<unsigned, std::string> load_slot_names(const std::string& robot, const std::string& file) {
-  std::map<unsigned, std::string> out;
+std::uint32_t code_fingerprint(std::span<const std::uint8_t> slot) {
+  // The frames as rcb4::ops::list_motions walks them: a size of 3-128 that fits, a sum that is
+  // right; the walk ends after a RETURN (03 0D 10, protocol.md §4.4) or before a frame that is none.
+  std::size_t at = 0;
+  while (at < slot.size()) {
+    const std::size_t size = slot[at];
+    if (size < 3 || size > rcb4::max_request_size || at + size > slot.size()) break;
+    unsigned sum = 0;
+    for (std::size_t i = at; i + 1 < at + size; ++i) sum += slot[i];
+    if ((sum & 0xFFu) != slot[at + size - 1]) break;
+    at += size;
+    if (size == 3 && slot[at - size + 1] == 0x0D) break;
+  }
+  return crc32(slot.first(at));
+}
+
+std::map<unsigned, slot_label> load_slot_labels(const std::string& robot, const std::string& file) {
+  std::map<unsigned, slot_label> out;
   const auto root = read_file(file);
   const auto names = root[robot];
   if (!names) return out;
@@ -60,19 +79,35 @@ std::map<unsigned, std::string> load_slot_names(const std::string& robot, const 
       throw refused(refusal_kind::usage,
                     fmt::format("{}:{}: '{}' is not a slot number", file, kv.first.Mark().line + 1, kv.first.Scalar()));
     }
-    if (kv.second.IsScalar()) out[n] = kv.second.Scalar();
+    if (kv.second.IsScalar()) {  // written before names were tied to code: kept, never shown
+      out[n] = slot_label{kv.second.Scalar(), std::nullopt};
+    } else if (kv.second.IsMap() && kv.second["name"] && kv.second["name"].IsScalar()) {
+      slot_label l{kv.second["name"].Scalar(), std::nullopt};
+      if (const auto c = kv.second["code"]; c && c.IsScalar()) {
+        const auto& text = c.Scalar();
+        std::uint32_t v = 0;
+        const auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), v, 16);
+        if (ec == std::errc{} && p == text.data() + text.size() && text.size() == 8) l.code = v;
+      }
+      out[n] = l;
+    }
   }
   return out;
 }
 
-void set_slot_name(const std::string& robot, unsigned n, const std::string& name, const std::string& file) {
+void set_slot_name(const std::string& robot, unsigned n, const std::string& name, std::optional<std::uint32_t> code,
+                   const std::string& file) {
   if (name.size() > 64 || name.find_first_of("\r\n") != std::string::npos)
     throw refused(refusal_kind::usage, fmt::format("the name '{}' is not one line of at most 64 characters", name));
   auto root = read_file(file);
   if (name.empty()) {
     if (root[robot] && root[robot].IsMap()) root[robot].remove(n);
   } else {
-    root[robot][n] = name;
+    YAML::Node entry(YAML::NodeType::Map);
+    entry.SetStyle(YAML::EmitterStyle::Flow);
+    entry["name"] = name;
+    if (code) entry["code"] = fmt::format("{:08x}", *code);
+    root[robot][n] = entry;
   }
   std::error_code ec;
   const fs::path path(file);
@@ -82,7 +117,8 @@ void set_slot_name(const std::string& robot, unsigned n, const std::string& name
     std::ofstream out(tmp, std::ios::trunc);
     YAML::Emitter e;
     e << root;
-    out << "# motion slot names kept by rcb4 (the board has no place for them): robot -> slot -> name\n"
+    out << "# motion slot names kept by rcb4 (the board has no place for them): robot -> slot -> name and the\n"
+        << "# CRC-32 of the code it names (a slot holding other code shows no name)\n"
         << e.c_str() << "\n";
     if (!out)
       throw refused(refusal_kind::usage,
@@ -95,14 +131,17 @@ void set_slot_name(const std::string& robot, unsigned n, const std::string& name
   }
 }
 
-std::string slot_name(const model& m, unsigned n, const std::map<unsigned, std::string>& names) {
-  if (const auto it = names.find(n); it != names.end() && !it->second.empty()) return it->second;
+std::string slot_name(const model& m, unsigned n, const std::map<unsigned, slot_label>& labels,
+                      std::span<const std::uint8_t> code) {
+  if (const auto it = labels.find(n); it != labels.end() && !it->second.name.empty() && it->second.code &&
+                                      !code.empty() && *it->second.code == code_fingerprint(code))
+    return it->second.name;
   return std::string(m.motion(n));
 }
 
-std::string slot_name(const model& m, unsigned n) {
+std::string slot_name(const model& m, unsigned n, std::span<const std::uint8_t> code) {
   try {
-    return slot_name(m, n, load_slot_names(m.name()));
+    return slot_name(m, n, load_slot_labels(m.name()), code);
   } catch (const refused&) {
     return std::string(m.motion(n));
   }

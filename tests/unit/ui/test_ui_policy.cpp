@@ -251,13 +251,44 @@ TEST_CASE("ui controller: a lost controlling page stops what it moved", "[ui]") 
   const auto e = c.leave(1);
   REQUIRE(e.actions.size() == 1);
   const auto& stop = std::get<stop_action>(e.actions[0].body);
-  REQUIRE(stop.joints.size() == 1);  // the knee it moved; the waiting head move was never sent
-  CHECK(stop.joints[0]->name == "left_knee");
+  // it had started a motion: every joint holds (the motion's pose under way would run on)
+  REQUIRE(stop.joints.size() == 2);
   CHECK(stop.motion);
   CHECK(!c.due_move(t0 + 1s));
   CHECK(!c.controlling());  // nobody is handed control: a page must ask
   CHECK(last_json(e)["controlled"] == false);
   CHECK(c.leave(1).actions.empty());  // twice: nothing
+}
+
+TEST_CASE("ui controller: a lost page that only moved joints holds those alone", "[ui]") {
+  const auto m = two_joints();
+  controller c(m);
+  c.join(1);
+  const auto t0 = clock::time_point{} + 1h;
+  c.receive(1, R"({"op":"move","joints":{"left_knee":30}})", t0);
+  REQUIRE(c.due_move(t0));
+  const auto e = c.leave(1);
+  REQUIRE(e.actions.size() == 1);
+  const auto& stop = std::get<stop_action>(e.actions[0].body);
+  REQUIRE(stop.joints.size() == 1);  // the knee it moved
+  CHECK(stop.joints[0]->name == "left_knee");
+  CHECK_FALSE(stop.motion);
+}
+
+TEST_CASE("ui controller: a watching page may stop, and nothing else that writes", "[ui]") {
+  const auto m = two_joints();
+  controller c(m);
+  c.join(1);
+  c.join(2);
+  const auto t0 = clock::time_point{} + 1h;
+  const auto stop = c.receive(2, R"({"op":"stop","id":3})", t0);
+  REQUIRE(stop.actions.size() == 1);
+  CHECK(std::holds_alternative<stop_action>(stop.actions[0].body));
+  CHECK(std::get<stop_action>(stop.actions[0].body).motion);
+  const auto mstop = c.receive(2, R"({"op":"motion_stop","id":4})", t0);
+  REQUIRE(mstop.actions.size() == 1);
+  CHECK(std::holds_alternative<motion_stop_action>(mstop.actions[0].body));
+  CHECK(c.receive(2, R"({"op":"motion_play","slot":2,"id":5})", t0).actions.empty());  // watching: refused
 }
 
 TEST_CASE("ui controller: a page that floods is slowed, then heard again", "[ui]") {
@@ -374,6 +405,11 @@ TEST_CASE("ui studio messages: each op's fields checked and only the controlling
   CHECK(parse_failure(R"({"op":"motion_check","text":")" + std::string(max_text_bytes + 1, 'x') + R"("})")
             .find("longer than") != std::string::npos);
   CHECK(parse_failure(R"({"op":"frobnicate"})").find("motion_push") != std::string::npos);  // the known ops listed
+  CHECK(parse_failure(R"({"op":"motion_put_back","slot":10,"base64":"%%"})") ==
+        "motion_put_back: 'base64' must be 1 to 60,000 characters of base64");
+  CHECK(parse_failure(R"({"op":"motion_put_back","slot":10})") == "motion_put_back: 'base64' is missing");
+  CHECK(parse_failure(R"({"op":"motion_put_back","slot":121,"base64":"AA=="})") ==
+        "motion_put_back: slot 121 is outside 1..120");
 
   const auto m = two_joints();
   controller c(m);

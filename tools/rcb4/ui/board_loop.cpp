@@ -238,7 +238,7 @@ class loop {
     j["poses"] = pose_names();
     json ms = json::array();
     for (const auto& v : motions_) {
-      const auto name = robot::services::slot_name(m_, v.number);
+      const auto name = robot::services::slot_name(m_, v.number, v.code);
       ms.push_back({{"slot", v.number},
                     {"name", name.empty() ? json(nullptr) : json(std::string(name))},
                     {"frames", v.frames},
@@ -284,7 +284,7 @@ class loop {
         } catch (const studio_refusal& r) {
           throw refusal{r.what()};
         }
-        if (st->op == "motion_push" || st->op == "motion_erase") refresh_lists();
+        if (st->op == "motion_push" || st->op == "motion_erase" || st->op == "motion_put_back") refresh_lists();
       } else {
         extra = std::visit([&](const auto& b) { return act(b); }, a.body);
       }
@@ -541,7 +541,7 @@ class loop {
       throw refusal{fmt::format("motion {} is code a motion file cannot say: {} (rcb4 motion show {} lists it)", a.slot,
                                 std::get<rcb4::motion::failure>(p).message, a.slot)};
     auto d = robot::from_program(std::get<rcb4::motion::program>(p), m_, *o_.layout, period_);
-    d.name = robot::services::slot_name(m_, a.slot);
+    d.name = robot::services::slot_name(m_, a.slot, bytes);
     const auto again = robot::to_program(d, m_, *o_.layout, period_);
     return json{{"slot", a.slot},
                 {"name", d.name},

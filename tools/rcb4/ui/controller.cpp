@@ -94,7 +94,12 @@ effects controller::leave(client_id c) {
   controller_.reset();
   pending_.clear();
   stop_action stop;
-  for (auto i : moved_) stop.joints.push_back(&model_->joints()[i]);
+  // A motion it started (ROM or from the host) moves every servo the motion names, up to a 2.55 s
+  // pose after its stop: every joint holds where it is then (docs/browser.md); else the ones it moved.
+  if (started_motion_)
+    for (const auto& j : model_->joints()) stop.joints.push_back(&j);
+  else
+    for (auto i : moved_) stop.joints.push_back(&model_->joints()[i]);
   stop.motion = started_motion_;
   if (!stop.joints.empty() || stop.motion) e.actions.push_back({c, std::nullopt, std::move(stop)});
   moved_.clear();

@@ -74,7 +74,9 @@ inline const json& required(const json& o, std::string_view op, std::string_view
 
 /** The ops studio_messages.cpp knows, for the message naming the known ones. */
 inline constexpr std::string_view studio_ops_list =
-    "motion_list, motion_pull, motion_check, buttons, trims, motion_push, motion_erase, motion_resume, play_motion, "
+    "motion_list, motion_pull, motion_check, buttons, trims, motion_push, motion_put_back, motion_erase, "
+    "motion_resume, "
+    "play_motion, "
     "button_set, button_clear, button_press, button_release, trim_set, hand, rom_backup, rom_restore_begin, "
     "rom_restore_piece, rom_restore_commit";
 

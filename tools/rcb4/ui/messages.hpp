@@ -25,6 +25,7 @@
 // Only the controlling page may change something:
 //   {"op":"motion_push","slot":10,"text":"...","dry_run":false}   write a motion (backup first)
 //   {"op":"motion_erase","slot":10}, {"op":"motion_resume"}
+//   {"op":"motion_put_back","slot":10,"base64":"...","file":"motion-10-….bin"}   a slot's .bin backup back
 //   {"op":"play_motion","text":"..."}                  play a motion file from the host ("stop" ends it)
 //   {"op":"button_set","buttons":"s1+up","slot":10}, {"op":"button_clear","buttons":"s1+up"}
 //   {"op":"button_press","buttons":"triangle","hold":true}, {"op":"button_release"}

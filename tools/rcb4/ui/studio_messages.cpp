@@ -44,6 +44,16 @@ std::optional<request> studio_body_of(const json& o, const std::string& op) {
     text_of(o, op);
     flag_of(o, op, "dry_run");
     r.writes = true;
+  } else if (op == "motion_put_back") {  // a slot's .bin backup (from a push or an erase) written back
+    only_keys(o, op, {"op", "id", "slot", "base64", "file"});
+    slot_of(o, op);
+    const auto& b = required(o, op, "base64");
+    if (!b.is_string() || b.get_ref<const std::string&>().empty() || b.get_ref<const std::string&>().size() > 60000 ||
+        b.get_ref<const std::string&>().find_first_not_of(
+            "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/=") != std::string::npos)
+      throw refused{"motion_put_back: 'base64' must be 1 to 60,000 characters of base64"};
+    if (o.contains("file")) (void)name_of(o.at("file"), op, "file");
+    r.writes = true;
   } else if (op == "motion_erase") {
     only_keys(o, op, {"op", "id", "slot"});
     slot_of(o, op);

@@ -82,8 +82,8 @@ std::uint16_t button_word(const std::string& text) {
   return std::get<std::uint16_t>(b);
 }
 
-json entries_json(const std::vector<rcb4::vector_entry>& entries, const rcb4::rom_layout& layout,
-                  const robot::model& m) {
+json entries_json(const std::vector<rcb4::vector_entry>& entries, const rcb4::rom_layout& layout, const robot::model& m,
+                  const std::map<unsigned, std::vector<std::uint8_t>>& codes) {
   json out = json::array();
   for (const auto& e : entries) {
     const auto b = e.buttons();
@@ -94,7 +94,10 @@ json entries_json(const std::vector<rcb4::vector_entry>& entries, const rcb4::ro
     out.push_back({{"buttons", b ? json(mo::buttons_text(*b)) : json(nullptr)},
                    {"word", b ? json(*b) : json(nullptr)},
                    {"slot", slot ? json(n) : json(nullptr)},
-                   {"name", slot ? json(sv::slot_name(m, n)) : json(nullptr)},
+                   {"name", slot ? json(sv::slot_name(m, n,
+                                                      codes.contains(n) ? std::span<const std::uint8_t>(codes.at(n))
+                                                                        : std::span<const std::uint8_t>{}))
+                                 : json(nullptr)},
                    {"address", a}});
   }
   return out;
@@ -156,11 +159,21 @@ json studio_ops::act(const studio_action& a, client_id from) {
   };
   try {
     const auto& op = a.op;
+    if (op == "motion_push" || op == "motion_put_back" || op == "motion_erase")
+      codes_.erase(slot());  // read again by the next list
     if (op == "motion_list") return list();
     if (op == "motion_pull") return pull(slot());
     if (op == "motion_check") return check(args.at("text").get<std::string>());
     if (op == "motion_push")
       return push(slot(), args.at("text").get<std::string>(), args.value("dry_run", false), backup);
+    if (op == "motion_put_back") {  // a .bin backup, as `rcb4 motion push FILE.bin N` puts it back
+      sv::push_source src;
+      src.bin = unbase64(args.at("base64").get<std::string>());
+      src.name = args.value("file", std::string("the backup"));
+      const auto r = sv::push_motion(link_, m_, *o_.layout, slot(), src, backup);
+      return json{{"slot", r.motion},   {"bytes", r.bytes.size()}, {"unchanged", r.unchanged},
+                  {"backup", r.backup}, {"summary", r.summary},    {"notes", r.notes}};
+    }
     if (op == "motion_erase") {
       const auto r = sv::erase_motion(link_, *o_.layout, slot(), backup, m_.name());
       return json{{"slot", r.motion}, {"unchanged", r.unchanged}, {"backup", r.backup}, {"callers", r.callers}};
@@ -175,7 +188,7 @@ json studio_ops::act(const studio_action& a, client_id from) {
       const auto word = button_word(args.at("buttons").get<std::string>());
       const auto r =
           op == "button_set" ? sv::set_button(link_, *o_.layout, word, slot()) : sv::clear_button(link_, word);
-      return json{{"done", r.done}, {"entries", entries_json(r.entries, *o_.layout, m_)}};
+      return json{{"done", r.done}, {"entries", entries_json(r.entries, *o_.layout, m_, codes_)}};
     }
     if (op == "button_press") {
       const auto r =
@@ -231,12 +244,17 @@ json studio_ops::list() {
   const auto& layout = *o_.layout;
   const auto used = sv::run(link_, rcb4::ops::list_motions(layout));
   const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
-  const auto names = sv::load_slot_names(m_.name());
+  const auto names = sv::load_slot_labels(m_.name());
   const auto states = sv::slot_states(used, layout);
+  codes_.clear();
+  for (const auto& v : used) codes_[v.number] = v.code;
   json slots = json::array();
   for (unsigned n = 1; n <= layout.motion_count; ++n) {
-    json e{{"slot", n}, {"name", sv::slot_name(m_, n, names)}};
     const auto it = std::find_if(used.begin(), used.end(), [&](const auto& v) { return v.number == n; });
+    json e{{"slot", n},
+           {"name", sv::slot_name(
+                        m_, n, names,
+                        it != used.end() ? std::span<const std::uint8_t>(it->code) : std::span<const std::uint8_t>{})}};
     e["used"] = it != used.end();
     if (it != used.end()) {
       e["bytes"] = it->size;
@@ -352,8 +370,8 @@ void studio_ops::stop() {
 json studio_ops::buttons() {
   const auto t = sv::read_buttons(link_);
   const auto cfg = sv::run(link_, rcb4::ops::read_config{});
-  return json{{"ram", entries_json(t.ram.entries, *o_.layout, m_)},
-              {"rom", entries_json(t.rom.entries, *o_.layout, m_)},
+  return json{{"ram", entries_json(t.ram.entries, *o_.layout, m_, codes_)},
+              {"rom", entries_json(t.rom.entries, *o_.layout, m_, codes_)},
               {"same", t.same()},
               {"problem", t.ram.problem.empty() ? json(nullptr) : json(t.ram.problem)},
               {"rom_program", cfg.rom_program}};
@@ -386,8 +404,9 @@ json studio_ops::hand(const std::string& joint, double degrees) {
 json studio_ops::rom_backup() {
   const auto image = sv::backup_rom(link_);
   const auto version = sv::run(link_, rcb4::ops::read_version{});
-  const auto file = fmt::format("rcb4-rom-{}.bin", sv::file_stamp());
-  // With its .crc32 line, as `rcb4 rom backup` writes it: `rcb4 rom restore FILE` checks the pair.
+  // One file, its CRC-32 in its name (a browser blocks a second automatic download): `rcb4 rom
+  // restore FILE` checks it without a .crc32 beside it; the .crc32 line comes along for those who want it.
+  const auto file = fmt::format("rcb4-rom-{}-crc32-{:08x}.bin", sv::file_stamp(), sv::crc32(image));
   return json{{"bytes", image.size()},
               {"crc32", fmt::format("{:08x}", sv::crc32(image))},
               {"crc32_line", sv::crc32_line(file, image, version)},

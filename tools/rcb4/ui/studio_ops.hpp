@@ -13,6 +13,7 @@
 #include <rcb4/robot/services/motion_slots.hpp>
 
 #include <chrono>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -69,6 +70,8 @@ class studio_ops {
   const loop_options& o_;
   session_link link_;
   std::unique_ptr<rcb4::robot::services::host_play> play_;
+  /** Each used slot's code as the last list() read it: the buttons' names are checked against it (slot_names.hpp). */
+  std::map<unsigned, std::vector<std::uint8_t>> codes_;
   clock::time_point play_start_{};
   std::optional<clock::time_point> play_next_;
   client_id play_from_ = 0;

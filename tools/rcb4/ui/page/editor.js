@@ -123,7 +123,7 @@ export function createEditor(root, ctx) {
     if (r.value === null) ctx.say(r.why || 'type a slot number, 1 to 120', 'error');
     return r.value;
   };
-  const file = el('input', { id: 'ed-file', type: 'file', accept: '.yaml,.yml,.json', hidden: true });
+  const file = el('input', { id: 'ed-file', type: 'file', accept: '.yaml,.yml,.json,.bin', hidden: true });
   const kind = el('select', { id: 'ed-kind', 'aria-label': 'kind of step to add' },
     ...Object.keys(KINDS).map((k) => el('option', { value: k, text: k.replace('_', ' ') })));
   const steps = el('ol', { id: 'ed-steps', class: 'steps', tabindex: 0, 'aria-label': 'the motion\'s steps: arrows select, Alt+arrows move, Delete removes, Ctrl+D duplicates, Ctrl+Z undoes' });
@@ -138,7 +138,7 @@ export function createEditor(root, ctx) {
   root.replaceChildren(
     el('div', { class: 'row' }, name,
       bt('ed-new', 'New', 'an empty motion', () => { if (mayReplace('New')) { load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] }); markClean(); } }),
-      bt('ed-open', 'Open…', 'a motion file (.yaml) from this computer', () => file.click()), file,
+      bt('ed-open', 'Open…', 'a motion file (.yaml) from this computer, or a slot\'s .bin backup to put back into the slot', () => file.click()), file,
       bt('ed-save', 'Save', 'download the motion as a motion file (.yaml), as rcb4 motion push reads it', save)),
     el('div', { class: 'row' }, 'slot', slot,
       bt('ed-pull', 'Pull', 'the slot into the editor', pull),
@@ -454,13 +454,16 @@ export function createEditor(root, ctx) {
       a.click();
       markClean();
       setTimeout(() => URL.revokeObjectURL(a.href), 5000);
-      ctx.say(r.problem ? `saved, but as it is it would not play: ${r.problem}` : `saved (${r.plays})`, r.problem ? 'error' : 'note');
+      // The page cannot know whether the browser kept the file: it says what it did.
+      ctx.say(r.problem ? `downloading ${a.download} (check your browser's downloads), but as it is it would not play: ${r.problem}`
+        : `downloading ${a.download} (${r.plays}): check your browser's downloads`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(e.message, 'error'); }
   }
   file.addEventListener('change', async () => {
     const f = file.files[0];
     if (!f) return;
     file.value = '';  // the same file chosen again opens again
+    if (/\.bin$/i.test(f.name)) return putBack(f);
     if (f.size > MAX_FILE_BYTES)  // beyond what a page may send: refused here, the connection kept
       return ctx.say(`${f.name}: ${Math.ceil(f.size / 1024)} KiB: a motion file may be up to ${MAX_FILE_BYTES / 1024} KiB (a slot holds a few KiB): not opened`, 'error');
     if (!mayReplace(`Opening ${f.name}`)) return ctx.say('open cancelled: the motion in the editor is kept');
@@ -471,6 +474,22 @@ export function createEditor(root, ctx) {
       ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
   });
+
+  // A slot's .bin backup (a push or an erase saved it) goes back into the slot typed, as `rcb4
+  // motion push FILE.bin N` puts it: checked, the slot's bytes backed up first, read back.
+  async function putBack(f) {
+    const n = slotIn(); if (n === null) return;
+    if (f.size === 0 || f.size > 16384) return ctx.say(`${f.name}: ${f.size} bytes: not a slot's backup (a slot holds at most a few KiB)`, 'error');
+    if (!window.confirm(`Write the backup ${f.name} (${f.size} bytes) into slot ${n}? The slot's bytes are backed up first.`)) return ctx.say('nothing written');
+    const bytes = new Uint8Array(await f.arrayBuffer());
+    let binary = '';
+    for (let i = 0; i < bytes.length; i += 8192) binary += String.fromCharCode(...bytes.subarray(i, i + 8192));
+    try {
+      const r = await ctx.request({ op: 'motion_put_back', slot: n, base64: btoa(binary), file: f.name.slice(0, 64) });
+      ctx.say(r.unchanged ? `slot ${n} already holds ${f.name}: nothing written` : `${f.name} is back in slot ${n} (${r.bytes} bytes); the bytes it replaced are in ${r.backup}`);
+      ctx.refresh();
+    } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
+  }
 
   // --- preview, play, stop ---
   function preview() {

@@ -151,14 +151,12 @@ export function createTables(root, ctx) {
     const r = await ask({ op: 'rom_backup' });
     if (!r) return;
     const bytes = Uint8Array.from(atob(r.base64), (c) => c.charCodeAt(0));
-    // The image and its .crc32 (as rcb4 rom backup writes them: rcb4 rom restore checks the pair).
-    for (const [blob, name] of [[new Blob([bytes], { type: 'application/octet-stream' }), r.file],
-      [new Blob([r.crc32_line], { type: 'text/plain' }), `${r.file}.crc32`]]) {
-      const a = el('a', { href: URL.createObjectURL(blob), download: name });
-      a.click();
-      setTimeout(() => URL.revokeObjectURL(a.href), 5000);
-    }
-    ctx.say(`ROM backed up: ${r.bytes} bytes, CRC-32 ${r.crc32} (${r.file} and ${r.file}.crc32)`);
+    // One download (a browser blocks a second one, and every later one with it): the CRC-32 is in
+    // the file's name, where rcb4 rom restore finds it.
+    const a = el('a', { href: URL.createObjectURL(new Blob([bytes], { type: 'application/octet-stream' })), download: r.file });
+    a.click();
+    setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+    ctx.say(`ROM read: ${r.bytes} bytes, CRC-32 ${r.crc32}; downloading ${r.file}: check your browser's downloads (rcb4 rom restore checks the CRC in its name)`);
   }
 
   // A restore: the image sent in pieces with its CRC-32; the server checks both, then the robot

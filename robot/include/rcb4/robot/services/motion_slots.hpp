@@ -102,6 +102,7 @@ struct push_report {
   std::string summary;              ///< "6 steps, 5 poses (plays 1.50 s)", or a .bin's content
   std::string name;                 ///< the name the slot now has (a motion file's name:), or empty
   std::vector<std::string> notes;   ///< what the motion does that may not be meant
+  std::uint32_t fingerprint = 0;    ///< code_fingerprint() of the slot now (slot_names.hpp; not for a dry run)
 };
 
 /** What a push writes: a motion file's document, or a backup's bytes put back as they are. */

@@ -47,6 +47,9 @@ void save_rom_image(const std::string& path, std::span<const std::uint8_t> image
  * (usage) naming what is wrong: unreadable, not rom_size bytes, a CRC that differs.
  */
 std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check);
+/** The CRC-32 a ROM image's file name carries ("rcb4-rom-STAMP-crc32-1a2b3c4d.bin": rcb4 ui's one-file backup), or "".
+ */
+std::string crc_in_name(const std::string& path);
 
 /** Saves the ROM a restore replaces and returns where it went (the front end's file I/O). */
 using rom_sink = std::function<std::string(std::span<const std::uint8_t> now)>;
