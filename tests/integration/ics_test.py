@@ -91,6 +91,19 @@ with ics_serve() as pty:
           f"eeprom backup onto an existing file is refused ({err.strip()})")
     rc, _, err = ics(pty, "eeprom", "backup", "a.bin", "--force")
     check(rc == 0, f"eeprom backup --force replaces it ({err.strip()})")
+    # Its CRC-32 beside it (trial L5): a bit flipped inside a field's range is caught, nothing written.
+    import zlib
+    crc = open("a.bin.crc32").read().split()[0] if os.path.exists("a.bin.crc32") else ""
+    check(crc == "%08x" % zlib.crc32(open("a.bin", "rb").read()), f"the backup's CRC-32 is beside it ({crc})")
+    flipped = bytearray(open("a.bin", "rb").read())
+    flipped[14] ^= 1  # byte 15, bit 0: rotation off -> on, a valid image
+    with open("flipped.bin", "wb") as f:
+        f.write(flipped)
+    with open("flipped.bin.crc32", "w") as f:
+        f.write(open("a.bin.crc32").read())
+    rc, _, err = ics(pty, "eeprom", "restore", "flipped.bin", "--dry-run")
+    check(rc == 2 and "the file changed or is damaged" in err and raw(pty) == before,
+          f"a backup whose bytes no longer match its .crc32: exit 2, nothing written ({err.strip()})")
     rc, _, err = run("--device", pty, "--trace", "ics", "temperature")
     check(rc == 0 and "->" in err and "A5 04" in err and "<-" in err and "25 04" in err,
           f"--trace shows the exchanges ({err.strip()[:200]})")

@@ -94,7 +94,10 @@ int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_v
     return exit_ok;
   }
   for (const auto& [f, v] : r.changed)
-    fmt::print("{:<18} {} -> {}\n", ics::info(f).name, value_text(f, r.before.get(f)), value_text(f, v));
+    fmt::print(
+        "{:<18} {} -> {}\n", ics::info(f).name,
+        r.before.stored_odd(f) ? fmt::format("{}.5 (stored odd)", r.before.get(f)) : value_text(f, r.before.get(f)),
+        value_text(f, v));
   if (dry_run)
     fmt::print("a dry run: nothing was written\n");
   else if (r.verified)

@@ -16,6 +16,7 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
     if (!ics::baud_code(b))
       throw refused(refusal_kind::usage, fmt::format("baud {}: an ICS line runs at 115200, 625000 or 1250000", b));
   std::vector<ics_found> found;
+  bool echoed = false;  // anything came back at any rate: an ICS adapter returns every byte it sends (ics.md §1)
   ics_options quick = o;
   quick.tries = 1;
   for (const auto b : order) {
@@ -28,6 +29,7 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
       const auto rx = l.transact(probe.view(), probe.size + 1, wait_for(probe.size + 1, b, o.timeout));
       const auto late = l.linger(o.timeout);
       heard = rx.size() > probe.size || !late.empty();
+      echoed = echoed || !rx.empty() || !late.empty();
     }
     if (!heard) continue;
     for (unsigned n = 0; n <= ics::servo_id::max; ++n) {
@@ -66,6 +68,13 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
     }
   }
   l.set_baud(order.front());
+  if (!echoed)
+    throw refused(refusal_kind::timeout,
+                  fmt::format("nothing came back at {} baud, not even the echo of the bytes sent: not an ICS line (an "
+                              "adapter in ICS mode returns every byte it sends, servo or not)",
+                              baud_list(order)),
+                  "is the adapter switched to ICS mode (not COM mode, which reaches an RCB-4 board)? is this port an "
+                  "RCB-4 board (use `rcb4 --device ...` without `ics`)? is a pty served?");
   return found;
 }
 

@@ -2,6 +2,7 @@
 // rcb4/robot/services/ics.hpp.
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/robot/services/ics.hpp>
+#include <rcb4/robot/services/rom.hpp>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -24,8 +25,13 @@ void save_ics_image(const std::string& path, const ics::eeprom_image& image, boo
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(reinterpret_cast<const char*>(image.bytes().data()), ics::eeprom_image::size);
   out.close();
-  if (!out)
-    throw refused(refusal_kind::usage, fmt::format("cannot write {}: {}", path, std::strerror(errno)),
+  // Its CRC-32 beside it (FILE.crc32, as a ROM backup's): a bit that flips in the file, inside a
+  // field's range, is caught when it is restored. The 64 bytes stay as the servo holds them.
+  std::ofstream sum(path + ".crc32", std::ios::trunc);
+  sum << crc32_line(std::filesystem::path(path).filename().string(), image.bytes(), "ICS EEPROM");
+  sum.close();
+  if (!out || !sum)
+    throw refused(refusal_kind::usage, fmt::format("cannot write {} or its .crc32: {}", path, std::strerror(errno)),
                   "nothing was written to the servo");
 }
 
@@ -52,6 +58,17 @@ ics::eeprom_image load_ics_image(const std::string& path) {
     throw refused(
         refusal_kind::usage,
         fmt::format("{} holds {} bytes; an ICS EEPROM backup is 64 (`rcb4 ics eeprom backup FILE`)", path, raw.size()));
+  // A backup rcb4 wrote has its CRC-32 beside it; one from another tool (64 bytes alone) has none.
+  if (std::ifstream sum(path + ".crc32"); sum) {
+    std::string word;
+    sum >> word;
+    const auto want = fmt::format("{:08x}", crc32(raw));
+    if (word != want)
+      throw refused(refusal_kind::usage,
+                    fmt::format("{} has CRC-32 {}, its .crc32 says {}: the file changed or is damaged; nothing written",
+                                path, want, word.empty() ? "nothing" : word),
+                    fmt::format("if you changed it on purpose, delete {}.crc32 (then it is read as it is)", path));
+  }
   auto e = ics::eeprom_image::parse(raw);
   if (!e)
     throw refused(refusal_kind::usage,

@@ -110,7 +110,27 @@ TEST_CASE("ics service refuses ID work with two servos and corrupt replies", "[i
   CHECK(kind_of([&] { ics_servo(bad, id_of(0), 115200); }) == refusal_kind::board);
   ics_virtual_link quiet(ics::virtual_line({ics::virtual_servo{}}, ics::line_faults{true, false}));
   CHECK(kind_of([&] { ics_servo(quiet, {}, {}); }) == refusal_kind::timeout);
-  CHECK(ics_scan(quiet, {}, {}).empty());
+  CHECK(ics_scan(quiet, {}, {}).empty());  // the echo came back: an ICS line with no servo
+  // Nothing at all comes back (an RCB-4 board's port, an adapter in COM mode): said, not "no servo".
+  struct dead final : ics_link {
+    std::uint32_t b = 115200;
+    std::vector<std::uint8_t> transact(std::span<const std::uint8_t>, std::size_t, std::chrono::milliseconds) override {
+      return {};
+    }
+    std::vector<std::uint8_t> linger(std::chrono::milliseconds) override { return {}; }
+    void set_baud(std::uint32_t baud) override { b = baud; }
+    std::uint32_t baud() const override { return b; }
+  } nothing;
+  for (const auto& f : {std::function<void()>([&] { (void)ics_scan(nothing, {}, {}); }),
+                        std::function<void()>([&] { ics_servo(nothing, {}, {}); })}) {
+    try {
+      f();
+      FAIL("not refused");
+    } catch (const refused& r) {
+      CHECK(r.kind == refusal_kind::timeout);
+      CHECK(std::string(r.what()).find("not even the echo") != std::string::npos);
+    }
+  }
 }
 
 TEST_CASE("ics service: ID set on a lone servo, moves, settings text", "[ics]") {
