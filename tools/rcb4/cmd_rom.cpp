@@ -102,8 +102,12 @@ void add_rom_commands(CLI::App& app, context& ctx) {
       "restore",
       "write FILE (from rom backup) into ROM where it differs, each piece read back; the ROM it replaces "
       "is saved first, beside FILE (rom-before-restore-DATE.bin)");
-  r->add_option("FILE", ro->file, "an image from rcb4 rom backup, checked against FILE.crc32")->required();
-  r->add_flag("--no-check", ro->no_check, "write an image that has no .crc32 beside it (its size is still checked)");
+  r->add_option(
+       "FILE", ro->file,
+       "an image from rcb4 rom backup, checked against FILE.crc32 (or the CRC-32 in its name: rcb4 ui's backup)")
+      ->required();
+  r->add_flag("--no-check", ro->no_check,
+              "write an image that has no CRC-32 beside it or in its name (its size is still checked)");
   r->add_flag("--force", ro->force_image,
               "write an image that does not look like an RCB-4 program (no boot code, no main loop, no HTH4 layout)");
   on_device(r, ctx, [&ctx, ro](session& s) { return restore(s, ro->file, ro->no_check, ro->force_image, ctx.g); });

@@ -105,9 +105,13 @@ std::vector<std::uint8_t> load_rom_image(const std::string& path, bool no_check)
     throw refused(refusal_kind::usage,
                   fmt::format("{} has CRC-32 {}, its .crc32 (or its name) says {}: the file changed or is damaged",
                               path, want, word),
-                  fmt::format("--no-check does not write a file that fails its check; if you changed {} on purpose, "
-                              "delete {}.crc32 and restore with --no-check",
-                              path, path));
+                  crc_in_name(path) == word && !std::filesystem::exists(path + ".crc32")
+                      ? fmt::format("--no-check does not write a file that fails its check; if you changed {} on "
+                                    "purpose, rename it without its -crc32-{} and restore with --no-check",
+                                    path, word)
+                      : fmt::format("--no-check does not write a file that fails its check; if you changed {} on "
+                                    "purpose, delete {}.crc32 and restore with --no-check",
+                                    path, path));
   return image;
 }
 

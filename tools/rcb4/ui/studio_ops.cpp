@@ -148,7 +148,12 @@ std::string studio_ops::backup_path(const std::string& what) const {
   const auto dir = o_.poses / "backups";
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);  // a folder that cannot be made: the save says why
-  return (dir / fmt::format("{}-{}.bin", what, sv::file_stamp())).string();
+  // Two backups in one second (an erase, then its backup put back) get -2, -3: a backup never
+  // replaces a file, and must never stop the work for a name.
+  const auto stamp = sv::file_stamp();
+  auto path = dir / fmt::format("{}-{}.bin", what, stamp);
+  for (int k = 2; std::filesystem::exists(path, ec); ++k) path = dir / fmt::format("{}-{}-{}.bin", what, stamp, k);
+  return path.string();
 }
 
 json studio_ops::act(const studio_action& a, client_id from) {

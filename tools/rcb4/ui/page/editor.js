@@ -170,12 +170,17 @@ export function createEditor(root, ctx) {
   function redo() { if (!ed.redo.length) return; ed.undo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.redo.pop())); render(); }
 
   // --- kept in the browser: the motion, its undo history and what was last saved survive a
-  // reconnect (a restarted rcb4 ui), a reload and a closed tab (localStorage, one per robot) ---
+  // reconnect (a restarted rcb4 ui) and a reload, per tab (sessionStorage: two tabs never
+  // overwrite each other's work); leaving the page with unsaved changes asks first ---
   const storeKey = `rcb4-studio-editor:${h.robot}`;
   let storeFailed = false;
+  let kept = null;
   function keep() {
     try {
-      localStorage.setItem(storeKey, JSON.stringify({ doc: ed.doc, sel: ed.sel, undo: ed.undo, redo: ed.redo, clean: ed.clean }));
+      const text = JSON.stringify({ doc: ed.doc, sel: ed.sel, undo: ed.undo, redo: ed.redo, clean: ed.clean });
+      if (text === kept) return;  // unchanged: nothing to write
+      sessionStorage.setItem(storeKey, text);
+      kept = text;
       storeFailed = false;
     } catch (e) {
       if (!storeFailed) ctx.say(`the browser would not keep the motion (${e.name}): save it to a file`, 'error');
@@ -184,13 +189,13 @@ export function createEditor(root, ctx) {
   }
   (function restore() {
     try {
-      const kept = JSON.parse(localStorage.getItem(storeKey) || 'null');
-      if (!kept || !kept.doc || !Array.isArray(kept.doc.steps) || !kept.doc.steps.length) return;
-      ed.doc = kept.doc;
-      ed.sel = Number.isInteger(kept.sel) ? kept.sel : 0;
-      ed.undo = Array.isArray(kept.undo) ? kept.undo.filter((u) => typeof u === 'string') : [];
-      ed.redo = Array.isArray(kept.redo) ? kept.redo.filter((u) => typeof u === 'string') : [];
-      ed.clean = typeof kept.clean === 'string' ? kept.clean : null;
+      const was = JSON.parse(sessionStorage.getItem(storeKey) || 'null');
+      if (!was || !was.doc || !Array.isArray(was.doc.steps) || !was.doc.steps.length) return;
+      ed.doc = was.doc;
+      ed.sel = Number.isInteger(was.sel) ? was.sel : 0;
+      ed.undo = Array.isArray(was.undo) ? was.undo.filter((u) => typeof u === 'string') : [];
+      ed.redo = Array.isArray(was.redo) ? was.redo.filter((u) => typeof u === 'string') : [];
+      ed.clean = typeof was.clean === 'string' ? was.clean : null;
     } catch { /* a damaged entry: start empty */ }
   }());
   ed.clean ??= snapshotDoc();
@@ -421,6 +426,7 @@ export function createEditor(root, ctx) {
   name.addEventListener('change', () => change(() => { ed.doc.name = name.value.trim(); }));
   function load(doc) {
     ed.undo.push(snapshot());
+    ed.redo = [];  // what was undone before belongs to the motion replaced
     ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: doc.steps?.length ? doc.steps : ['end'] };
     ed.sel = 0;
     render();
@@ -486,8 +492,8 @@ export function createEditor(root, ctx) {
     for (let i = 0; i < bytes.length; i += 8192) binary += String.fromCharCode(...bytes.subarray(i, i + 8192));
     try {
       const r = await ctx.request({ op: 'motion_put_back', slot: n, base64: btoa(binary), file: f.name.slice(0, 64) });
+      ctx.refresh();  // first: the refresh's own answer would take the place of what is said here
       ctx.say(r.unchanged ? `slot ${n} already holds ${f.name}: nothing written` : `${f.name} is back in slot ${n} (${r.bytes} bytes); the bytes it replaced are in ${r.backup}`);
-      ctx.refresh();
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
   }
 

@@ -125,21 +125,32 @@ export async function createView(box, hello, opts = {}) {
     camera.aspect = w / h;
     camera.updateProjectionMatrix();
   };
-  new ResizeObserver(resize).observe(box);
-  resize();
+  // Drawn when something changed (the state, the ghost, the camera, the size), not 60 times a
+  // second while nothing moves: an idle page costs no CPU (software GL draws slowly).
+  let pending = false;
   const frame = () => {
+    pending = false;
     renderer.render(scene, camera);
     stats.frames += 1;
+  };
+  const invalidate = () => {
+    if (pending) return;
+    pending = true;
     requestAnimationFrame(frame);
   };
-  requestAnimationFrame(frame);
+  new ResizeObserver(() => { resize(); invalidate(); }).observe(box);
+  resize();
+  controls.addEventListener('change', invalidate);
+  invalidate();
 
   const view = {
     stats,
     canvas,
     /** The measured angles (joint → degrees; null: unknown). */
     setMeasured(angles) {
+      if (Object.entries(angles).every(([k, a]) => measured[k] === a)) return;  // nothing moved: nothing to draw
       Object.assign(measured, angles);
+      invalidate();
       // Unknown angles (the board does not answer) are drawn as nothing, never as 0°: a joint
       // without one keeps its last pose, and the body is greyed out while any is unknown.
       const known = Object.fromEntries(Object.entries(measured).filter(([, a]) => Number.isFinite(a)));
@@ -150,11 +161,12 @@ export async function createView(box, hello, opts = {}) {
     },
     /** The ghost's angles (joint → degrees), or null to hide it. */
     setGhost(angles) {
+      invalidate();
       ghost.root.visible = !!angles;
       if (angles) { for (const k of Object.keys(edited)) delete edited[k]; Object.assign(edited, angles); pose(ghost, edited); }
     },
     /** Highlights joint @p name's limb (null: none). */
-    select(name) { selected = name; paint(solid, measured); paint(ghost, edited); },
+    select(name) { selected = name; paint(solid, measured); paint(ghost, edited); invalidate(); },
     get selected() { return selected; },
   };
   return view;
