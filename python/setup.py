@@ -21,7 +21,9 @@ class CMakeBuild(build_ext):
 
     def build_extension(self, ext):
         build = Path(self.build_temp).resolve() / "cmake"
-        subprocess.run(["cmake", "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
+        # Ninja when it is there (cmake/install-deps.sh installs it; make may not be on the machine)
+        generator = ["-G", "Ninja"] if shutil.which("ninja") and not (build / "CMakeCache.txt").exists() else []
+        subprocess.run(["cmake", *generator, "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
                         f"-DPython_EXECUTABLE={sys.executable}", "-DRCB4_BUILD_TESTS=OFF",
                         "-DRCB4_BUILD_EXAMPLES=OFF", "-DRCB4_BUILD_TOOLS=OFF", "-DRCB4_BUILD_BENCHMARKS=OFF", "-DRCB4_INSTALL=OFF"],
                        check=True)

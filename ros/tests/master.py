@@ -14,8 +14,11 @@ def start(pyrcb4_dir, node_src, name="/rcb4_test"):
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
+    # ROS_IP: every node on loopback by address, so the machine's host name need not resolve.
     env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{port}", ROS_HOME=tempfile.mkdtemp(prefix="rcb4-ros-"),
-               PYTHONPATH=os.pathsep.join([pyrcb4_dir, node_src, os.environ.get("PYTHONPATH", "")]))
+               ROS_IP="127.0.0.1", PYTHONPATH=os.pathsep.join([pyrcb4_dir, node_src, os.environ.get("PYTHONPATH", "")]))
+    env.pop("ROS_HOSTNAME", None)
+    os.environ.pop("ROS_HOSTNAME", None)
     os.environ.update(env)
     master = subprocess.Popen(["rosmaster", "--core", "-p", str(port)], stdout=subprocess.DEVNULL,
                               stderr=subprocess.DEVNULL)
