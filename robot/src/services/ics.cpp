@@ -53,13 +53,7 @@ ics_servo::ics_servo(ics_link& l, std::optional<ics::servo_id> id, std::optional
       return;
     }
   }
-  if (!echoed)
-    throw refused(refusal_kind::timeout,
-                  fmt::format("nothing came back at {} baud, not even the echo of the bytes sent: not an ICS line (an "
-                              "adapter in ICS mode returns every byte it sends, servo or not)",
-                              baud_list(order)),
-                  "is the adapter switched to ICS mode (not COM mode, which reaches an RCB-4 board)? is this port an "
-                  "RCB-4 board (use `rcb4 --device ...` without `ics`)? is a pty served?");
+  if (!echoed) throw no_echo(order);
   throw refused(
       refusal_kind::timeout,
       id ? fmt::format("ICS servo {} does not answer at {} baud ({} rounds)", id->value(), baud_list(order), rounds)

@@ -69,6 +69,16 @@ inline std::chrono::milliseconds wait_for(std::size_t bytes, std::uint32_t baud,
   return std::chrono::milliseconds(ics::wire_micros(bytes, baud) / 1000 + 1) + allowance;
 }
 
+/** Nothing came back at any of @p order, not even the echo: no ICS line (ics.md §1: an adapter in ICS mode echoes). */
+inline refused no_echo(std::span<const std::uint32_t> order) {
+  return refused(refusal_kind::timeout,
+                 fmt::format("nothing came back at {} baud, not even the echo of the bytes sent: not an ICS line (an "
+                             "adapter in ICS mode returns every byte it sends, servo or not)",
+                             baud_list(order)),
+                 "is the adapter switched to ICS mode (not COM mode, which reaches an RCB-4 board)? is this port an "
+                 "RCB-4 board (use `rcb4 --device ...` without `ics`)? is a pty served?");
+}
+
 }  // namespace ics_detail
 
 template <class Cmd>

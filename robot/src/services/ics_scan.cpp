@@ -68,13 +68,7 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
     }
   }
   l.set_baud(order.front());
-  if (!echoed)
-    throw refused(refusal_kind::timeout,
-                  fmt::format("nothing came back at {} baud, not even the echo of the bytes sent: not an ICS line (an "
-                              "adapter in ICS mode returns every byte it sends, servo or not)",
-                              baud_list(order)),
-                  "is the adapter switched to ICS mode (not COM mode, which reaches an RCB-4 board)? is this port an "
-                  "RCB-4 board (use `rcb4 --device ...` without `ics`)? is a pty served?");
+  if (!echoed) throw no_echo(order);
   return found;
 }
 
