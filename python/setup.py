@@ -21,8 +21,14 @@ class CMakeBuild(build_ext):
 
     def build_extension(self, ext):
         build = Path(self.build_temp).resolve() / "cmake"
-        # Ninja when it is there (cmake/install-deps.sh installs it; make may not be on the machine)
-        generator = ["-G", "Ninja"] if shutil.which("ninja") and not (build / "CMakeCache.txt").exists() else []
+        # Ninja when it is there (cmake/install-deps.sh installs it; make may not be on the machine);
+        # a build folder left by another generator (an earlier try without Ninja) is made anew.
+        generator = []
+        if shutil.which("ninja"):
+            generator = ["-G", "Ninja"]
+            cache = build / "CMakeCache.txt"
+            if cache.exists() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" not in cache.read_text(errors="replace"):
+                shutil.rmtree(build)
         subprocess.run(["cmake", *generator, "-S", str(ROOT), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release",
                         f"-DPython_EXECUTABLE={sys.executable}", "-DRCB4_BUILD_TESTS=OFF",
                         "-DRCB4_BUILD_EXAMPLES=OFF", "-DRCB4_BUILD_TOOLS=OFF", "-DRCB4_BUILD_BENCHMARKS=OFF", "-DRCB4_INSTALL=OFF"],
