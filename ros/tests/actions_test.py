@@ -116,8 +116,11 @@ try:
     # Two joints, two points.
     client.send_goal(goal([([10, 20], 0.4), ([-10, 0], 0.8)], joints=("left_knee", "head_yaw")))
     client.wait_for_result(rospy.Duration(10))
-    check(client.get_state() == GoalStatus.SUCCEEDED and abs(position("left_knee") + 10) < 1
-          and abs(position("head_yaw")) < 1, f"a two-point goal of two joints succeeds ({client.get_state()})")
+    # SUCCEEDED when its time is up (as joint_trajectory_controller without goal tolerances); the
+    # joint_states this test receives lag on a loaded machine: read until they arrive, bounded.
+    there = wait_for(lambda: abs(position("left_knee") + 10) < 1 and abs(position("head_yaw")) < 1, timeout=3)
+    check(client.get_state() == GoalStatus.SUCCEEDED and there,
+          f"a two-point goal of two joints succeeds ({client.get_state()}, {position('left_knee')}, {position('head_yaw')})")
 
     # Refused goals: nothing moves.
     for g, code, what in ((goal([(20, 1.0)], joints=("no_such_joint",)), Result.INVALID_JOINTS, "an unknown joint"),
