@@ -229,9 +229,16 @@ TEST_CASE("measure_link: a board that is not paced is measured as it is, not as 
   auto c = open_client(io, b.server->where());
   c.options().baud = 1250000;
   t::error_code ec;
-  const auto cost = t::measure_link(c, ec, 5);
+  // 126 more bytes took less than half their 1.1 ms at 1.25 Mbaud: the bytes cost what was
+  // measured. A measurement is timing: on a loaded machine one may come out slow, so it is
+  // measured up to five times, and the link must be seen unpaced in one of them (a paced link
+  // never is: the test above).
+  auto cost = t::measure_link(c, ec, 5);
   REQUIRE_FALSE(ec);
-  // 126 more bytes took less than half their 1.1 ms at 1.25 Mbaud: the bytes cost what was measured.
+  for (int again = 0; again < 4 && cost.byte_time >= 4400ns; ++again) {
+    cost = t::measure_link(c, ec, 5);
+    REQUIRE_FALSE(ec);
+  }
   CHECK(cost.byte_time < 4400ns);
   CHECK(cost.exchange > 0ns);  // an exchange still costs something: the round trip through the pty
   // So the planner merges, as it should on such a link (a read costs little more for more bytes),

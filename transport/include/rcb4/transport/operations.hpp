@@ -107,35 +107,35 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps) {
 
 /**
  * Measures what a read costs on @p c: the planner's link_cost (ops::plan_reads, protocol.md §4).
- * Times @p samples 2-byte and @p samples 128-byte reads of RAM and takes the fastest of each (a loaded computer only
- * adds time). The exchange cost is what a read takes beyond its bytes' time on the wire (adapter latency, the board's
- * turnaround, the operating system): on a fast link the planner then reads joints one by one, behind a millisecond of
- * USB latency it merges them into long reads. The bytes cost the client's rate (options().baud, 11 bits a byte) as long
- * as the 126 extra bytes of the long read take at least half their wire time. When they take less, the line is not
- * paced at that rate (a pty, a board in process, a bridge that buffers): the cost is then the measured time per byte
- * and the rest of the short read, so plans fit the link as it is instead of a rate it does not have. Sets @p ec if an
- * exchange fails.
+ * Times @p samples 2-byte and @p samples 128-byte reads of RAM and takes the medians. The
+ * exchange cost is what a read takes beyond its bytes' time on the wire (adapter latency, the
+ * board's turnaround, the operating system): on a fast link the planner then reads joints one by
+ * one, behind a millisecond of USB latency it merges them into long reads.
+ * The bytes cost the client's rate (options().baud, 11 bits a byte) as long as the 126 extra bytes
+ * of the long read take at least half their wire time. When they take less, the line is not paced
+ * at that rate (a pty, a board in process, a bridge that buffers): the cost is then the measured
+ * time per byte and the rest of the short read, so plans fit the link as it is instead of a rate
+ * it does not have. Sets @p ec if an exchange fails.
  */
 template <AsyncByteStream Stream>
 ops::link_cost measure_link(basic_client<Stream>& c, error_code& ec, int samples = 9) {
   const command short_read = move::read_ram(ram::config, 2).value();
   const command long_read = move::read_ram(ram::user_area, 128).value();
-  // The fastest of each: what a busy computer adds (a late wake-up, another program's turn) only
-  // ever adds time, so the minimum is what the link itself costs (a median drifts with the load).
-  const auto fastest_of = [&](const command& read) {
-    std::chrono::nanoseconds best{0};
+  const auto median_of = [&](const command& read) {
+    std::vector<std::chrono::nanoseconds> times;
     for (int i = 0; i < samples && !ec; ++i) {
       const auto t0 = std::chrono::steady_clock::now();
       c.execute(read, ec);
-      const auto t = std::chrono::steady_clock::now() - t0;
-      if (i == 0 || t < best) best = t;
+      times.push_back(std::chrono::steady_clock::now() - t0);
     }
-    return ec ? std::chrono::nanoseconds{0} : best;
+    if (ec || times.empty()) return std::chrono::nanoseconds{0};
+    std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
+    return times[times.size() / 2];
   };
   c.execute(short_read, ec);  // the first exchange may pay for a cold path; it is not counted
   if (ec) return {};
-  const auto t_short = fastest_of(short_read);
-  const auto t_long = fastest_of(long_read);
+  const auto t_short = median_of(short_read);
+  const auto t_long = median_of(long_read);
   if (ec || samples <= 0) return {};
   const auto baud = c.options().baud > 0 ? c.options().baud : 115200u;
   auto cost = ops::link_cost::at(baud, {});
