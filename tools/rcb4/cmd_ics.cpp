@@ -65,6 +65,11 @@ std::string value_text(ics::field f, long v) {
   return std::to_string(v);
 }
 
+/** Field @p f of @p e as value_text shows it, a stretch another tool stored odd as "N.5 (stored odd)". */
+std::string field_text(const ics::eeprom_image& e, ics::field f) {
+  return e.stored_odd(f) ? fmt::format("{}.5 (stored odd)", e.get(f)) : value_text(f, e.get(f));
+}
+
 /** ICSSW p6's temperature points (value, °C), smaller is hotter (ics.md §3; the scales disagree, §7.3). */
 double icssw_celsius(int v) {
   constexpr std::pair<double, double> pts[] = {{30, 100}, {47, 90}, {60, 80}, {75, 70}, {87, 60}};
@@ -94,10 +99,7 @@ int print_report(const sv::ics_eeprom_report& r, const globals& g, std::string_v
     return exit_ok;
   }
   for (const auto& [f, v] : r.changed)
-    fmt::print(
-        "{:<18} {} -> {}\n", ics::info(f).name,
-        r.before.stored_odd(f) ? fmt::format("{}.5 (stored odd)", r.before.get(f)) : value_text(f, r.before.get(f)),
-        value_text(f, v));
+    fmt::print("{:<18} {} -> {}\n", ics::info(f).name, field_text(r.before, f), value_text(f, v));
   if (dry_run)
     fmt::print("a dry run: nothing was written\n");
   else if (r.verified)
@@ -125,9 +127,7 @@ int show_image(const ics::eeprom_image& e, const std::string& title, const globa
     return exit_ok;
   }
   fmt::print("{}\n", title);
-  for (const auto& i : ics::fields)
-    fmt::print("  {:<18} {:<22} {}\n", i.name,
-               e.stored_odd(i.f) ? fmt::format("{}.5 (stored odd)", e.get(i.f)) : value_text(i.f, e.get(i.f)), i.what);
+  for (const auto& i : ics::fields) fmt::print("  {:<18} {:<22} {}\n", i.name, field_text(e, i.f), i.what);
   fmt::print("  raw {}\n", raw);
   return exit_ok;
 }
