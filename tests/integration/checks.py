@@ -39,3 +39,22 @@ def tool(program):
             srv.wait(timeout=10)
 
     return run, serve
+
+
+def ics_server(program, *args):
+    """A context manager: `rcb4 ics serve --pty ARGS` for the duration of a with block, yielding its
+    device path; it must end with 0 on SIGTERM (checked)."""
+    import contextlib
+    import subprocess
+
+    @contextlib.contextmanager
+    def serving():
+        srv = subprocess.Popen([program, "ics", "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
+        try:
+            yield srv.stdout.readline().strip()
+        finally:
+            srv.terminate()
+            srv.wait(timeout=10)
+            check(srv.returncode == 0, f"ics serve {' '.join(args)} ends with 0 on SIGTERM (got {srv.returncode})")
+
+    return serving()

@@ -12,27 +12,20 @@ import os
 import pty
 import re
 import select
-import subprocess
 import sys
 import tempfile
 import threading
 import tty
 
 sys.path.insert(0, os.path.dirname(__file__))
-from checks import check, finish, tool  # noqa: E402
+from checks import check, finish, ics_server, tool  # noqa: E402
 
 RCB4 = sys.argv[1]
 run, _ = tool(RCB4)
 
 
-@contextlib.contextmanager
 def ics_serve(*args):
-    srv = subprocess.Popen([RCB4, "ics", "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
-    try:
-        yield srv.stdout.readline().strip()
-    finally:
-        srv.terminate()
-        srv.wait(timeout=10)
+    return ics_server(RCB4, *args)
 
 
 @contextlib.contextmanager

@@ -3,7 +3,6 @@
 # temperature, and the refusals (two servos, silent, corrupt, wrong baud, bad values, another
 # servo's backup): exit codes and output, nothing written when refused.
 # SPDX-License-Identifier: BSL-1.0
-import contextlib
 import json
 import os
 import signal
@@ -13,22 +12,15 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(__file__))
-from checks import check, finish, tool  # noqa: E402
+from checks import check, finish, ics_server, tool  # noqa: E402
 
 RCB4 = sys.argv[1]
 run, _ = tool(RCB4)
 FACTORY = [n for n in range(1, 65) if 25 <= n <= 26 or 33 <= n <= 50 or 55 <= n <= 56]
 
 
-@contextlib.contextmanager
 def ics_serve(*args):
-    srv = subprocess.Popen([RCB4, "ics", "serve", "--pty", *args], stdout=subprocess.PIPE, text=True)
-    try:
-        yield srv.stdout.readline().strip()
-    finally:
-        srv.terminate()
-        srv.wait(timeout=10)
-        check(srv.returncode == 0, f"ics serve {' '.join(args)} ends with 0 on SIGTERM (got {srv.returncode})")
+    return ics_server(RCB4, *args)
 
 
 def ics(pty, *args, json_out=False):
