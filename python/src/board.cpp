@@ -7,6 +7,7 @@
 #include <rcb4/robot/services/moves.hpp>
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
+#include <rcb4/transport/share.hpp>
 #include <rcb4/transport/tcp.hpp>
 
 #include <fmt/format.h>
@@ -15,6 +16,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 
 namespace pyrcb4 {
@@ -53,6 +55,14 @@ void raise(const std::error_code& ec, const std::string& what) {
 }
 
 namespace {
+/** The share of @p path when rcb4 ui holds it and serves it, with its process id in @p holder. */
+std::optional<t::local_socket> connect_shared(boost::asio::io_context& io, const std::string& path, int& holder) {
+  t::error_code ec;
+  auto socket = t::connect_share(io, path, ec, &holder);
+  if (ec) return std::nullopt;
+  return socket;
+}
+
 stream adopt(boost::asio::io_context& io, int fd) {
   const int own = ::dup(fd);
   if (own < 0) throw board_error(fault::device, std::string("dup: ") + std::strerror(errno));
@@ -94,6 +104,13 @@ board::board(const std::string& device, std::uint32_t baud, const std::string& r
     if (ec) raise(ec, path);
     opt.baud = baud ? baud : 115200;  // the bridge's rate is unknown: the slowest gives safe deadlines
     baud_known_ = baud != 0;
+    client_ = std::make_unique<client>(adopt(io_->context(), socket.native_handle()), opt);
+  } else if (int holder = 0; auto shared = board_ ? std::nullopt : connect_shared(io_->context(), path, holder)) {
+    // A port rcb4 ui holds is reached through it (transport/share.hpp), sharing its one FIFO.
+    auto& socket = *shared;
+    where_ = path + " (through rcb4 ui, pid " + std::to_string(holder) + ")";
+    opt.baud = baud ? baud : 115200;  // the studio's rate is not ours to know: the slowest gives safe deadlines
+    baud_known_ = false;
     client_ = std::make_unique<client>(adopt(io_->context(), socket.native_handle()), opt);
   } else {
     if (baud == 0) {

@@ -10,6 +10,7 @@
 
 #include <rcb4/transport/detect.hpp>
 #include <rcb4/transport/serial.hpp>
+#include <rcb4/transport/share.hpp>
 #include <rcb4/transport/tcp.hpp>
 
 #include <termios.h>
@@ -176,6 +177,20 @@ session::session(const globals& g) {
     client_ = std::make_unique<client>(adopt(io_.context(), socket.native_handle()), opt);
     return;
   }
+  // A port held by rcb4 ui is reached through it (transport/share.hpp): the studio's one FIFO
+  // carries our exchanges between its own, and its page sees what we change.
+  rcb4::transport::error_code shared_ec;
+  int holder = 0;
+  if (auto socket = rcb4::transport::connect_share(io_.context(), path, shared_ec, &holder); !board_ && !shared_ec) {
+    where_ = fmt::format("{} (through rcb4 ui, pid {})", path, holder);
+    if (g.trace) fmt::print(stderr, "rcb4: {} is held by rcb4 ui (pid {}): going through it\n", path, holder);
+    rate_known_ = false;  // the studio's rate is not ours to know: the slowest gives safe deadlines
+    opt.baud = g.baud.value_or(115200);
+    client_ = std::make_unique<client>(adopt(io_.context(), socket.native_handle()), opt);
+    client_->execute(rcb4::ping{rcb4::ping_form::short_});
+    shared_ = true;
+    return;
+  }
   if (g.baud) {
     baud = *g.baud;
   } else {
@@ -194,6 +209,7 @@ session::session(const globals& g) {
   opt.baud = baud;
   client_ = std::make_unique<client>(adopt(io_.context(), port.native_handle()), opt);
   client_->execute(rcb4::ping{rcb4::ping_form::short_});
+  holds_port_ = !board_;
 }
 
 session::~session() {
@@ -365,7 +381,9 @@ failure explain(const std::error_code& ec, std::string_view what) {
             "a board answered but its reply stopped short: a noisy or failing line, a wrong baud, or a board "
             "busy with something else"};
   if (ec == t::transport_errc::port_busy)
-    return {exit_io, std::string(what), "another program has the port open (`fuser -v` on the device shows which)"};
+    return {exit_io, std::string(what),
+            "another program has the port open (`fuser -v` on the device shows which); a port rcb4 ui holds is "
+            "reached through it, by the same user"};
   if (ec == std::errc::permission_denied)
     return {exit_io, std::string(what),
             "no permission: join the dialout group or install the udev rule (`rcb4 doctor` says how)"};

@@ -145,6 +145,10 @@ class session {
   const std::string& where() const noexcept { return where_; }
   /** True when no --device was given. */
   bool is_virtual() const noexcept { return board_ != nullptr; }
+  /** True when this session opened --device's serial port itself (what rcb4 ui shares). */
+  bool holds_port() const noexcept { return holds_port_; }
+  /** True when --device is held by rcb4 ui and this session goes through it (transport/share.hpp). */
+  bool shared() const noexcept { return shared_; }
   /**
    * The virtual board's hand: turns ICS @p n to @p position when its servo is free (on the
    * board's own thread). Returns the servo's output word (+6: 0x8000 when it was free and turned),
@@ -180,6 +184,8 @@ class session {
   std::unique_ptr<client> client_;
   std::string where_;
   bool rate_known_ = true;
+  bool holds_port_ = false;
+  bool shared_ = false;
 };
 
 /** A progress line on stderr for long work: only on a terminal, never under --json. */

@@ -4,6 +4,8 @@
 #include "ui/board_loop.hpp"
 #include "ui/server.hpp"
 
+#include <rcb4/transport/share.hpp>
+
 #include <boost/asio/ip/host_name.hpp>
 #include <boost/asio/signal_set.hpp>
 
@@ -113,6 +115,9 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
   }
 
   session s(ctx.g);  // the device (or the in-process virtual robot): its failures exit 1/3/4 as everywhere
+  if (s.shared())
+    throw failure(exit_io, fmt::format("{} is held by another rcb4 ui: {}", ctx.g.device, s.where()),
+                  "open that studio's page (one studio per board), or stop it first");
 
   ui::settings limits;
   limits.max_speed = o.speed;
@@ -129,10 +134,37 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
   lo.device = s.where();
   h.set_hello(ui::hello_text(m, s, lo, limits));
 
+  // The command line next to the studio: the port this studio holds is served to the user's other
+  // programs (rcb4 --device PORT, pyrcb4), through the session's client and its one FIFO
+  // (transport/share.hpp). The board loop re-reads what they may have changed.
+  auto outside_writes = std::make_shared<std::atomic<std::uint64_t>>(0);  // the client's thread may outlive this frame
+  std::shared_ptr<rcb4::transport::share_server<client>> share;
+  if (s.holds_port()) {
+    rcb4::transport::error_code ec;
+    share = rcb4::transport::share_server<client>::start(
+        io, s.c(), ctx.g.device,
+        [outside_writes](const rcb4::command& c, const rcb4::transport::error_code&, const rcb4::transport::response&) {
+          if (!rcb4::transport::is_idempotent(c)) ++*outside_writes;
+        },
+        ec);
+    if (ec)
+      fmt::print(stderr, "rcb4 ui: cannot share {} with other programs ({}): they will find it busy\n", s.where(),
+                 ec.message());
+    lo.outside_writes = outside_writes.get();
+  }
+  struct share_stopper {
+    std::shared_ptr<rcb4::transport::share_server<client>>& s;
+    ~share_stopper() {
+      if (s) s->stop();
+    }
+  } stop_share{share};
+
   // The first line of stdout is the URL (scripts read it); the rest goes to stderr.
   fmt::print("{}\n", url_of(server->local(), so.token));
   std::fflush(stdout);
   fmt::print(stderr, "rcb4 ui: {} on {}; poses in {}; Ctrl-C stops\n", m.name(), s.where(), o.poses);
+  if (share)
+    fmt::print(stderr, "rcb4 ui: `rcb4 --device {}` and pyrcb4 reach the board through this studio\n", ctx.g.device);
 
   boost::asio::signal_set signals(io, SIGINT, SIGTERM);
   std::string loop_failure;
@@ -144,6 +176,7 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
       boost::asio::post(io, [&] {
         signals.cancel();
         server->stop();
+        if (share) share->stop();
       });
     }
   });
@@ -160,6 +193,7 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
     if (ec) return;
     h.stop();  // the loop ends after the exchange under way; joined once io.run() returns
     server->stop();
+    if (share) share->stop();  // its acceptor would keep io.run() going
   });
   server->start(h);
   io.run();

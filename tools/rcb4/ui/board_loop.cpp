@@ -66,6 +66,7 @@ class loop {
         carry_out(a);
       }
       if (h_.stopped()) return;
+      notice_outside_writes();
       if (auto done = studio_.tick()) h_.tell(done->to, done->text);  // a motion played from the host
       // After a slider move the board shows it once it has taken its first step, one output period
       // on: the page hears then, not a page period later. Other work is shown at once.
@@ -97,6 +98,28 @@ class loop {
   auto run_ec(Op op, t::error_code& ec) {
     t::run(s_.c(), op, ec);
     return op.value();
+  }
+
+  /**
+   * Another program changed the board through the studio's share of the port: once it has been
+   * quiet for 300 ms (a push writes in many pieces), the lists are read again and pages told.
+   */
+  void notice_outside_writes() {
+    if (!o_.outside_writes) return;
+    const auto n = o_.outside_writes->load();
+    if (n != outside_seen_) {
+      outside_unseen_ += n - outside_seen_;
+      outside_seen_ = n;
+      outside_at_ = clock::now();
+    } else if (outside_unseen_ > 0 && clock::now() - outside_at_ >= 300ms) {
+      refresh_lists();
+      json j;
+      j["type"] = "note";
+      j["text"] = fmt::format("another program (rcb4 or pyrcb4, through this studio) changed the board: {} write{}",
+                              outside_unseen_, outside_unseen_ == 1 ? "" : "s");
+      h_.tell(0, text_of(j));
+      outside_unseen_ = 0;
+    }
   }
 
   // --- reading -------------------------------------------------------------------------------
@@ -570,6 +593,9 @@ class loop {
   std::uint64_t last_exchanges_ = 0;
   double rate_ = 0;
   clock::time_point last_rate_at_;
+  std::uint64_t outside_seen_ = 0;    // o_.outside_writes when last looked at
+  std::uint64_t outside_unseen_ = 0;  // writes not yet told to the pages
+  clock::time_point outside_at_;      // when the last of them was seen
 };
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "../app.hpp"
 #include "hub.hpp"
 
+#include <atomic>
 #include <filesystem>
 #include <string>
 
@@ -17,6 +18,8 @@ struct loop_options {
   const rcb4::rom_layout* layout = &rcb4::hth4_2_2;  ///< where the motions are in ROM
   std::chrono::milliseconds period{33};              ///< one reading per period at most (~30 a second)
   std::string device;                                ///< for the page: what is open
+  /** Counts the writes other programs made through the studio's share of the port (or null). */
+  const std::atomic<std::uint64_t>* outside_writes = nullptr;
 };
 
 /**

@@ -116,7 +116,7 @@ const on = {
     }[m.op];
     if (what) say(what());
   },
-  note(m) { say((m.clamped || []).join('; ')); },
+  note(m) { say(m.text ?? (m.clamped || []).join('; ')); },
   error(m) {
     const p = ui.pending.get(m.id);
     if (p) { ui.pending.delete(m.id); p.reject(new Error((m.op ? m.op + ': ' : '') + m.message)); return; }
