@@ -5,6 +5,7 @@
 #include "studio_ops.hpp"
 
 #include <rcb4/motion/disassemble.hpp>
+#include <rcb4/robot/mirror.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/moves.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
@@ -606,9 +607,28 @@ std::string hello_text(const robot::model& m, const session& s, const loop_optio
   json j;
   j["type"] = "hello";
   j["robot"] = m.name();
+  // Each joint's mirror image (robot/mirror.hpp), from the body: the page mirrors a pose and
+  // copies a limb with it; null where the body gives none (nothing is guessed from names).
+  std::vector<std::string> names;
+  for (const auto& jt : m.joints()) names.push_back(jt.name);
+  const auto images =
+      m.body() ? robot::mirror_images(*m.body(), names) : std::vector<std::optional<robot::mirror_image>>(names.size());
   json joints = json::array();
-  for (const auto& jt : m.joints())
-    joints.push_back({{"name", jt.name}, {"ics", jt.ics.value()}, {"lower", jt.lower}, {"upper", jt.upper}});
+  for (std::size_t n = 0; n < names.size(); ++n) {
+    const auto& jt = m.joints()[n];
+    json mirror = nullptr;
+    if (const auto& i = images[n])
+      mirror = {{"joint", names[i->joint]},
+                {"sign", i->sign},
+                {"side", i->left    ? "left"
+                         : i->right ? "right"
+                                    : "middle"}};
+    joints.push_back({{"name", jt.name},
+                      {"ics", jt.ics.value()},
+                      {"lower", jt.lower},
+                      {"upper", jt.upper},
+                      {"mirror", std::move(mirror)}});
+  }
   j["joints"] = std::move(joints);
   json groups = json::array();
   for (const auto& g : m.groups()) groups.push_back({{"name", g.name}, {"joints", g.joints}});

@@ -4,6 +4,7 @@
 // services): pushed to a slot with its backup named, pulled from one, played from the host at the
 // authored timing, previewed in 3D without the robot, opened from and saved to a file.
 
+import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
 import { el, $, numberIn } from './dom.js';
 
 const KINDS = {
@@ -150,6 +151,8 @@ export function createEditor(root, ctx) {
       bt('ed-add', 'Add', 'add a step of that kind after the selected one (a pose: the ghost\'s)', () => add(kind.value)),
       bt('ed-capture', 'Capture', 'add the robot\'s measured pose (all joints, or the ticked ones of the selected pose)', capture),
       bt('ed-dup', 'Duplicate', 'Ctrl+D', () => duplicate()),
+      bt('ed-copy', 'Copy pose', 'Ctrl+C: the selected pose, for any motion or tab of this robot', copy),
+      bt('ed-paste', 'Paste pose', 'Ctrl+V: the copied pose as a new step after the selected one', paste),
       bt('ed-del', 'Delete', 'Delete', () => remove()),
       bt('ed-up', '↑', 'Alt+↑', () => move(-1)), bt('ed-down', '↓', 'Alt+↓', () => move(1)),
       bt('ed-undo', 'Undo', 'Ctrl+Z', undo), bt('ed-redo', 'Redo', 'Ctrl+Y', redo)),
@@ -251,6 +254,38 @@ export function createEditor(root, ctx) {
     ctx.say(`captured ${Object.keys(pose).length} joints` + (outside.length ? ` (at the limit: ${outside.join(', ')})` : ''));
   }
   function duplicate() { const s = ed.doc.steps[ed.sel]; if (s !== undefined) insert(JSON.parse(JSON.stringify(s))); }
+  // --- poses: copy and paste (every tab of this robot), mirror, a limb onto the other, home ---
+  function copy() {
+    const s = ed.doc.steps[ed.sel];
+    if (kindOf(s) !== 'pose') return ctx.say('select a pose step to copy', 'error');
+    const failed = copyPose(h.robot, s);
+    ctx.say(failed ?? `pose of step ${ed.sel + 1} copied: paste it in any motion or tab (Ctrl+V)`, failed ? 'error' : 'note');
+  }
+  function paste() {
+    const r = pastedPose(h);
+    if (!r.step) return ctx.say(r.why, 'error');
+    insert(r.step);
+  }
+  /** Replaces the selected pose's joints by @p fn(pose) → { pose } or { why }; live on the robot when ticked. */
+  function reshape(fn) {
+    const s = ed.doc.steps[ed.sel];
+    if (kindOf(s) !== 'pose') return;
+    const r = fn(s.pose);
+    if (!r.pose) return ctx.say(r.why, 'error');
+    change(() => { s.pose = r.pose; });
+    if (ed.live) sendLive(r.pose);
+  }
+  function home() {  // every joint of the pose at 0°, the robot's home with its trims
+    reshape((pose) => {
+      const out = {};
+      for (const n of Object.keys(pose)) {
+        const j = limits.get(n);
+        if (j && (0 < j.lower || 0 > j.upper)) return { why: `${n}: 0° is beyond its limits ${j.lower}..${j.upper}` };
+        out[n] = 0;
+      }
+      return { pose: out };
+    });
+  }
   function remove() {
     if (ed.doc.steps.length <= 1) return;
     change(() => { ed.doc.steps.splice(ed.sel, 1); clampSel(); });
@@ -272,6 +307,8 @@ export function createEditor(root, ctx) {
       if (e.altKey) move(d); else { ed.sel += d; clampSel(); render(); }
     } else if (key === 'Delete') remove();
     else if (mod && key.toLowerCase() === 'd') duplicate();
+    else if (mod && key.toLowerCase() === 'c') copy();
+    else if (mod && key.toLowerCase() === 'v') paste();
     else if (mod && key.toLowerCase() === 'z') undo();
     else if (mod && key.toLowerCase() === 'y') redo();
     else return;
@@ -368,8 +405,13 @@ export function createEditor(root, ctx) {
       tick.checked = on;
       const slider = el('input', { type: 'range', min: j.lower, max: j.upper, step: 0.5, value: v, disabled: !on, 'aria-label': `${j.name} degrees` });
       const num = el('input', { type: 'number', step: 0.5, value: Math.round(v * 10) / 10, disabled: !on, 'aria-label': `${j.name} degrees, typed` });
+      const before = poseAt(ed.sel - 1)[j.name];
+      const same = el('button', { type: 'button', class: 'as-before', text: '↶', disabled: !on || !Number.isFinite(before),
+        title: Number.isFinite(before) ? `as in the pose before: ${Math.round(before * 10) / 10}°` : 'no angle before this pose',
+        'aria-label': `${j.name} as in the pose before` });
+      same.addEventListener('click', () => set(before, true));
       const row = el('div', { class: 'pose-joint' + (on && (v < j.lower || v > j.upper) ? ' beyond' : ''), 'data-joint': j.name },
-        tick, el('span', { class: 'name', text: j.name }), slider, num);
+        tick, el('span', { class: 'name', text: j.name }), slider, num, same);
       tick.addEventListener('change', () => {
         if (!tick.checked) return change(() => { delete s.pose[j.name]; });
         // the joint joins the pose at the angle its box shows, checked as a typed one is
@@ -413,8 +455,15 @@ export function createEditor(root, ctx) {
       });
       return row;
     });
+    const mirrorable = canMirror(h), noBody = mirrorable ? '' : ' (this robot\'s profile has no body: kinematics)';
+    const tools = el('div', { class: 'row small' },
+      bt('ed-mirror', 'Mirror ⇄', 'the pose mirrored left ↔ right (from the robot\'s body)' + noBody, () => reshape((p) => mirrorPose(h, p, 'both'))),
+      bt('ed-l2r', 'Left → right', 'the left limbs\' angles onto the right ones' + noBody, () => reshape((p) => mirrorPose(h, p, 'left'))),
+      bt('ed-r2l', 'Right → left', 'the right limbs\' angles onto the left ones' + noBody, () => reshape((p) => mirrorPose(h, p, 'right'))),
+      bt('ed-home', 'Home', 'every joint of this pose at 0° (the robot\'s home, with its trims)', home));
+    for (const id of ['ed-mirror', 'ed-l2r', 'ed-r2l']) tools.querySelector(`#${id}`).disabled = !mirrorable;
     detail.replaceChildren(el('div', { class: 'row small' }, `step ${ed.sel + 1}: pose over`, time, 'ms',
-      el('label', { class: 'small' }, live, ' live on the robot')), el('div', { class: 'pose-joints' }, ...rows));
+      el('label', { class: 'small' }, live, ' live on the robot')), tools, el('div', { class: 'pose-joints' }, ...rows));
     ctx.controls();
   }
 
@@ -561,6 +610,9 @@ export function createEditor(root, ctx) {
   return {
     load, render,
     get doc() { return ed.doc; },
+    /** The selected step's index; setting it selects that step (tests). */
+    get sel() { return ed.sel; },
+    set sel(i) { ed.sel = i; render(); },
     /** The undo and redo depths, and whether the motion has unsaved changes (tests). */
     get history() { return { undo: ed.undo.length, redo: ed.redo.length, dirty: dirty() }; },
     /** A motion played from the host ended (the server's "played"). */

@@ -1,0 +1,119 @@
+#!/usr/bin/env python3
+# The pose work HTH4 users do every day, in the studio (issue 41 item 8), in Debian's headless
+# Chromium over `rcb4 serve --pty`: a pose mirrored left <-> right has the paired joints swapped
+# with their signs right (KHR-3HV: head yaw negated, pitch, roll and yaw of the limbs kept, as
+# robot/mirror.hpp works out from the body); a limb copied onto the other; Home; a joint "as in the
+# pose before"; a pose copied in one tab and pasted in another tab's motion; undo after each; and
+# with "live on the robot" off, none of it moves the robot (read through the studio's share).
+# Usage: studio_poses_test.py RCB4
+# SPDX-License-Identifier: BSL-1.0
+import json
+import sys
+import tempfile
+
+from checks import check, finish
+from uihelp import tools
+
+RCB4 = sys.argv[1]
+run, serve, Ui, browser, wait_until, joints_on = tools(RCB4)
+
+
+def js(driver, code, *args):
+    return driver.execute_script(code, *args)
+
+
+def click(driver, what):
+    js(driver, "document.getElementById(arguments[0]).click()", what)
+
+
+def typed(driver, joint, degrees):
+    js(driver, """const n = document.querySelector(`.pose-joint[data-joint="${arguments[0]}"] input[type=number]`);
+                  n.value = arguments[1]; n.dispatchEvent(new Event('change'));""", joint, degrees)
+
+
+def pose(driver, step=None):
+    return js(driver, """const e = window.rcb4Studio.editor; const s = e.doc.steps[arguments[0] ?? e.sel];
+                         return s && s.pose ? s.pose : null;""", step)
+
+
+def message(driver):
+    return js(driver, "return document.querySelector('#message').textContent")
+
+
+with serve() as dev, tempfile.TemporaryDirectory() as poses:
+    ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
+    driver = browser()
+    try:
+        driver.get(ui.url)
+        check(wait_until(lambda: js(driver, "return !!(window.rcb4Studio && window.rcb4Studio.editor)"), timeout=20),
+              "the studio is up")
+        hello = js(driver, "return window.rcb4Studio.hello")
+        mirror = {j["name"]: j["mirror"] for j in hello["joints"]}
+        check(mirror["head_yaw"] == {"joint": "head_yaw", "sign": -1, "side": "middle"}
+              and mirror["left_knee"] == {"joint": "right_knee", "sign": 1, "side": "left"}
+              and mirror["right_shoulder_roll"] == {"joint": "left_shoulder_roll", "sign": 1, "side": "right"},
+              f"hello gives each joint its mirror image ({mirror['head_yaw']}, {mirror['left_knee']})")
+        before = {n: j["degrees"] for n, j in joints_on(dev).items()}
+
+        click(driver, "ed-new")
+        js(driver, "document.querySelector('#ed-kind').value = 'pose'")
+        click(driver, "ed-add")  # a pose of every joint, from the robot as it stands
+        for joint, deg in (("head_yaw", 20), ("left_knee", 45), ("right_knee", 10), ("left_shoulder_roll", 30),
+                           ("right_shoulder_roll", -5), ("left_elbow_yaw", 12)):
+            typed(driver, joint, deg)
+        p0 = pose(driver)
+        click(driver, "ed-mirror")
+        p = pose(driver)
+        check(p["head_yaw"] == -20 and p["left_knee"] == 10 and p["right_knee"] == 45
+              and p["left_shoulder_roll"] == -5 and p["right_shoulder_roll"] == 30 and p["right_elbow_yaw"] == 12
+              and p["left_elbow_yaw"] == p0["right_elbow_yaw"],
+              f"Mirror: pairs swapped, head yaw negated ({json.dumps(p)})")
+        click(driver, "ed-undo")
+        check(pose(driver) == p0, "one Undo: the pose as typed")
+        click(driver, "ed-l2r")
+        p = pose(driver)
+        check(p["right_knee"] == 45 and p["left_knee"] == 45 and p["right_shoulder_roll"] == 30
+              and p["head_yaw"] == 20, f"Left → right: the left limbs onto the right, the middle kept ({json.dumps(p)})")
+        click(driver, "ed-undo")
+        click(driver, "ed-r2l")
+        p = pose(driver)
+        check(p["left_knee"] == 10 and p["left_shoulder_roll"] == -5 and p["right_knee"] == 10,
+              f"Right → left ({json.dumps(p)})")
+        click(driver, "ed-undo")
+
+        # A second pose: Home, then one joint as in the pose before.
+        click(driver, "ed-add")
+        typed(driver, "right_knee", 30)
+        click(driver, "ed-home")
+        p = pose(driver)
+        check(p and all(v == 0 for v in p.values()), f"Home: every joint of the pose at 0° ({json.dumps(p)})")
+        js(driver, """document.querySelector('.pose-joint[data-joint="left_knee"] .as-before').click()""")
+        p = pose(driver)
+        check(p["left_knee"] == 45 and p["right_knee"] == 0, f"↶ left_knee as in the pose before: 45 ({p['left_knee']})")
+
+        # Copy in this tab, paste into another tab's motion.
+        js(driver, "window.rcb4Studio.editor.sel = 1")
+        click(driver, "ed-copy")
+        first = driver.current_window_handle
+        driver.switch_to.new_window("tab")
+        driver.get(ui.url)
+        check(wait_until(lambda: js(driver, "return !!(window.rcb4Studio && window.rcb4Studio.editor)"), timeout=20),
+              "a second tab")
+        click(driver, "ed-new")
+        click(driver, "ed-paste")
+        steps = js(driver, "return window.rcb4Studio.editor.doc.steps")
+        pasted = [s for s in steps if isinstance(s, dict) and "pose" in s]
+        check(len(pasted) == 1 and pasted[0]["pose"] == p, f"the other tab pastes the copied pose ({len(pasted)} poses)")
+        driver.close()
+        driver.switch_to.window(first)
+
+        # Nothing of it moved the robot: live was off.
+        after = {n: j["degrees"] for n, j in joints_on(dev).items()}
+        moved = [n for n in before if abs((after[n] or 0) - (before[n] or 0)) > 0.2]
+        check(not moved, f"with live off no joint moved ({moved})")
+    finally:
+        driver.quit()
+        rc = ui.stop()
+    check(rc == 0, f"rcb4 ui ended with exit 0 ({rc})")
+
+finish()
