@@ -91,6 +91,30 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         p = pose(driver)
         check(p["left_knee"] == 45 and p["right_knee"] == 0, f"↶ left_knee as in the pose before: 45 ({p['left_knee']})")
 
+        # Scrub the timeline: pressed at its middle, the ghost is between the two poses (500 ms each:
+        # the end of the first, right_knee 10 -> 0); a preview from step 2 starts there.
+        def pointer(kind, fraction):
+            js(driver, """const t = document.getElementById('ed-timeline'), r = t.getBoundingClientRect();
+                          t.dispatchEvent(new PointerEvent(arguments[0], {bubbles: true, pointerId: 1,
+                            clientX: r.left + r.width * arguments[1], clientY: r.top + r.height / 2}));""", kind, fraction)
+            return js(driver, "return window.rcb4Studio.view.ghost")
+
+        g = pointer("pointerdown", 0.25)
+        check(g and abs(g["right_knee"] - 5) < 1 and abs(g["left_knee"] - 22.5) < 1,
+              f"the timeline pressed a quarter in: the ghost half way into pose 1 ({g and (g['right_knee'], g['left_knee'])})")
+        g = pointer("pointermove", 0.75)
+        check(g and abs(g["right_knee"] - 5) < 1 and abs(g["left_knee"] - 45) < 1 and abs(g["head_yaw"] - 10) < 1,
+              f"dragged to three quarters: half way from pose 1 to pose 2 ({g and (g['right_knee'], g['head_yaw'])})")
+        pointer("pointerup", 0.75)
+        js(driver, "window.rcb4Studio.editor.sel = 1")
+        click(driver, "ed-preview-here")
+        start = js(driver, "return window.rcb4Studio.editor.previewFrom")
+        g = wait_until(lambda: js(driver, "const g = window.rcb4Studio.view.ghost; return g && g.left_knee === 45 && g")
+                       , timeout=3)
+        check(start == 500 and g and g["left_knee"] == 45,
+              f"From here: the preview starts where the board reaches step 2, 500 ms in ({start}, {g and g['right_knee']})")
+        click(driver, "ed-stop")
+
         # Copy in this tab, paste into another tab's motion.
         js(driver, "window.rcb4Studio.editor.sel = 1")
         click(driver, "ed-copy")

@@ -133,6 +133,45 @@ export function createEditor(root, ctx) {
   const timeline = el('div', { id: 'ed-timeline', class: 'timeline', 'aria-label': 'the poses in time' });
   const cursor = el('div', { class: 'cursor', hidden: true });
   timeline.append(cursor);
+  // Scrubbing: a press and drag along the timeline shows the pose at that point in the ghost
+  // (the poses in the list's order, each joint moving in a straight line as the board moves it).
+  const scrubAt = (e) => {
+    const poses = ed.doc.steps.map((st, i) => [st, i]).filter(([st]) => kindOf(st) === 'pose');
+    const total = poses.reduce((a, [st]) => a + st.time_ms, 0);
+    if (!total) return;
+    const r = timeline.getBoundingClientRect();
+    const t = Math.min(Math.max((e.clientX - r.left) / r.width, 0), 1) * total;
+    let acc = 0;
+    for (const [st, i] of poses) {
+      if (t <= acc + st.time_ms) {
+        const from = poseAt(i - 1), f = st.time_ms ? (t - acc) / st.time_ms : 1, g = { ...from };
+        for (const [n, v] of Object.entries(st.pose)) g[n] = Number.isFinite(from[n]) ? from[n] + (v - from[n]) * f : v;
+        ctx.view?.setGhost(g);
+        cursor.hidden = false;
+        cursor.style.left = `${(t / total) * 100}%`;
+        timeline.dataset.scrubStep = String(i);
+        return;
+      }
+      acc += st.time_ms;
+    }
+  };
+  timeline.addEventListener('pointerdown', (e) => {
+    if (ed.preview) return;
+    try { timeline.setPointerCapture(e.pointerId); } catch { /* a pointer the browser no longer tracks */ }
+    timeline.dataset.scrubbing = String(e.clientX);
+    scrubAt(e);
+  });
+  timeline.addEventListener('pointermove', (e) => { if (timeline.dataset.scrubbing) scrubAt(e); });
+  const scrubEnd = (e) => {
+    if (!timeline.dataset.scrubbing) return;
+    const still = Math.abs(e.clientX - Number(timeline.dataset.scrubbing)) < 4;  // a click, not a drag
+    delete timeline.dataset.scrubbing;
+    cursor.hidden = true;
+    if (still && timeline.dataset.scrubStep) { ed.sel = Number(timeline.dataset.scrubStep); render(); }  // selects its pose
+    else ctx.view?.setGhost(poseAt(ed.sel));  // the selected pose again
+  };
+  timeline.addEventListener('pointerup', scrubEnd);
+  timeline.addEventListener('pointercancel', scrubEnd);
   const detail = el('div', { id: 'ed-detail', class: 'detail' });
   const summary = el('div', { id: 'ed-summary', class: 'small muted' });
   const bt = (id, text, title, fn, cls = '') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
@@ -144,7 +183,8 @@ export function createEditor(root, ctx) {
     el('div', { class: 'row' }, 'slot', slot,
       bt('ed-pull', 'Pull', 'the slot into the editor', pull),
       bt('ed-push', 'Push', 'write the motion into the slot (its old bytes are backed up first)', push, 'needs-control'),
-      bt('ed-preview', 'Preview', 'play it in 3D, at its timing, without the robot', preview),
+      bt('ed-preview', 'Preview', 'play it in 3D, at its timing, without the robot', () => preview(false)),
+      bt('ed-preview-here', 'From here', 'preview from the selected step (where the board first reaches it)', () => preview(true)),
       bt('ed-play', 'Play on robot', 'play it from the host at its timing (the first pose is reached at the speed limit)', play, 'needs-control'),
       bt('ed-stop', 'Stop', 'stop the preview and a play on the robot', stop)),
     el('div', { class: 'row' }, kind,
@@ -547,12 +587,20 @@ export function createEditor(root, ctx) {
   }
 
   // --- preview, play, stop ---
-  function preview() {
+  /** Plays the motion in 3D; @p fromSel: from the first time the board reaches the selected step. */
+  function preview(fromSel = false) {
     stop();
     let segs;
     try { segs = segments(ed.doc.steps, ctx.measured()); } catch (e) { return ctx.say(`preview: ${e.message}`, 'error'); }
     const total = segs.reduce((a, g) => a + g.ms, 0);
-    const t0 = performance.now();
+    let skip = 0;
+    if (fromSel) {
+      const k = segs.findIndex((g) => g.step >= ed.sel);
+      if (k < 0) return ctx.say(`preview: the motion never reaches step ${ed.sel + 1} (no button held, RAM 0)`, 'error');
+      skip = segs.slice(0, k).reduce((a, g) => a + g.ms, 0);
+    }
+    const t0 = performance.now() - skip;
+    ed.previewFrom = skip;
     cursor.hidden = false;
     $('#ed-result').textContent = 'previewing…';
     const tick = () => {
@@ -613,6 +661,8 @@ export function createEditor(root, ctx) {
     /** The selected step's index; setting it selects that step (tests). */
     get sel() { return ed.sel; },
     set sel(i) { ed.sel = i; render(); },
+    /** Where the last preview started, ms into the motion (tests). */
+    get previewFrom() { return ed.previewFrom ?? null; },
     /** The undo and redo depths, and whether the motion has unsaved changes (tests). */
     get history() { return { undo: ed.undo.length, redo: ed.redo.length, dirty: dirty() }; },
     /** A motion played from the host ended (the server's "played"). */

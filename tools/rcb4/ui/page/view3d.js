@@ -168,6 +168,8 @@ export async function createView(box, hello, opts = {}) {
     /** Highlights joint @p name's limb (null: none). */
     select(name) { selected = name; paint(solid, measured); paint(ghost, edited); invalidate(); },
     get selected() { return selected; },
+    /** The ghost's angles as last set (null while hidden): tests and the benchmark read it. */
+    get ghost() { return ghost.root.visible ? { ...edited } : null; },
   };
   return view;
 }
