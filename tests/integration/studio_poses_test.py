@@ -131,6 +131,60 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         driver.close()
         driver.switch_to.window(first)
 
+        # Every other kind of step from a form, nothing typed as JSON: a loop with a counter, a
+        # button branch clicked on the remote's picture, a speed; pushed, and the board has it.
+        js(driver, "window.confirm = () => true")  # New over an unsaved motion asks first
+        click(driver, "ed-new")
+
+        def add(kind):
+            js(driver, "document.querySelector('#ed-kind').value = arguments[0]", kind)
+            click(driver, "ed-add")
+
+        def field(fid, value):
+            js(driver, """const f = document.getElementById(arguments[0]); f.value = arguments[1];
+                          f.dispatchEvent(new Event('change'));""", fid, value)
+
+        add("label")
+        field("f-label", "again")
+        click(driver, "ed-step-apply")
+        add("set_counter")
+        box = driver.find_element("id", "f-count")
+        box.clear()
+        box.send_keys("abc")  # as typed: a number box holds no value then (validity.badInput)
+        click(driver, "ed-step-apply")
+        bad = message(driver)
+        # (Chromium keeps letters out of a number box: it is left empty, and an empty count is no count)
+        check("nothing changed" in bad and js(driver, "return window.rcb4Studio.editor.doc.steps[1]") == {"set_counter": 3},
+              f"letters in the count: said, the step unchanged ({bad!r})")
+        field("f-count", "4")
+        click(driver, "ed-step-apply")
+        add("pose")
+        add("if_buttons")
+        js(driver, "document.querySelectorAll('#ed-detail .key[data-button=up]')[0].click()")  # the default 'up' off
+        for b in ("s1", "circle"):
+            js(driver, "document.querySelector(`#ed-detail .key[data-button=${arguments[0]}]`).click()", b)
+        field("f-goto", "again")
+        click(driver, "ed-step-apply")
+        add("loop")
+        field("f-goto", "again")
+        click(driver, "ed-step-apply")
+        add("speed")
+        js(driver, """const t = document.querySelector('#ed-detail .param-target'); t.value = 'legs';
+                      document.querySelector('#ed-detail .param-value').value = 60;""")
+        click(driver, "ed-step-apply")
+        steps = js(driver, "return window.rcb4Studio.editor.doc.steps")
+        shape = [s if not (isinstance(s, dict) and "pose" in s) else "pose" for s in steps]
+        check(shape == [{"label": "again"}, {"set_counter": 4}, "pose", {"if_buttons": "s1+circle", "goto": "again"},
+                        {"loop": "again"}, {"speed": {"legs": 60}}, "end"],
+              f"the steps as the forms made them ({shape})")
+        field("ed-slot", "11")
+        click(driver, "ed-push")
+        check(wait_until(lambda: "slot 11" in message(driver) or "backup" in message(driver), timeout=20),
+              f"pushed to slot 11 ({message(driver)!r})")
+        rc, out, err = run("--device", dev, "motion", "show", "11")
+        check(rc == 0 and "MOV literal {04}" in out and "CONST 20 servos" in out,
+              f"rcb4 motion show 11, through the studio, lists it ({rc}, {out[:300]!r} {err.strip()!r})")
+
         # Nothing of it moved the robot: live was off.
         after = {n: j["degrees"] for n, j in joints_on(dev).items()}
         moved = [n for n in before if abs((after[n] or 0) - (before[n] or 0)) > 0.2]

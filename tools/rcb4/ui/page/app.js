@@ -389,6 +389,7 @@ async function buildStudio(h) {
     say,
     view: null,
     measured: () => ({ ...ui.measured }),
+    motions: () => ui.motions,
     controlling: () => ui.role === 'control',
     controls: () => setRole(ui.role, ui.controlled),
     refresh: () => { send({ op: 'refresh' }); ui.studio?.tables.list(); },

@@ -5,6 +5,7 @@
 // authored timing, previewed in 3D without the robot, opened from and saved to a file.
 
 import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
+import { stepForm } from './stepforms.js';
 import { el, $, numberIn } from './dom.js';
 
 const KINDS = {
@@ -412,15 +413,15 @@ export function createEditor(root, ctx) {
 
   function renderDetail() {
     const s = ed.doc.steps[ed.sel];
-    if (kindOf(s) !== 'pose') {
-      const text = el('input', { id: 'ed-step-text', value: JSON.stringify(s), 'aria-label': 'the step as a motion file says it (JSON)' });
+    if (kindOf(s) !== 'pose') {  // a form for its kind: nothing typed as JSON
+      const form = stepForm(s, ed.doc, ctx);
       const apply = el('button', { type: 'button', id: 'ed-step-apply' }, 'Apply');
       apply.addEventListener('click', () => {
-        let v;
-        try { v = JSON.parse(text.value); } catch { return ctx.say('the step is not JSON', 'error'); }
-        change(() => { ed.doc.steps[ed.sel] = v; });
+        const r = form.read();
+        if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}: nothing changed`, 'error');
+        change(() => { ed.doc.steps[ed.sel] = r.step; });
       });
-      detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), el('div', { class: 'row' }, text, apply));
+      detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), form.el, el('div', { class: 'row' }, apply));
       return;
     }
     // A pose takes one board period at least (0 ms would snap the robot to it) and 255 frames at most.

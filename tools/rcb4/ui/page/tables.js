@@ -4,12 +4,7 @@
 // Every change goes through the server's robot services, with their checks and refusals.
 
 import { el, numberIn } from './dom.js';
-
-// The KRR remote's buttons (motion/buttons.hpp), laid out as on the pad: [name, column, row].
-const PAD = [['s1', 0, 0], ['s2', 1, 0], ['s3', 5, 0], ['s4', 6, 0],
-  ['up', 1, 1], ['triangle', 5, 1], ['left', 0, 2], ['right', 2, 2], ['square', 4, 2], ['circle', 6, 2],
-  ['down', 1, 3], ['cross', 5, 3]];
-const SYMBOL = { up: '▲', down: '▼', left: '◀', right: '▶', triangle: '△', circle: '○', cross: '✕', square: '□' };
+import { PAD, SYMBOL } from './remote.js';
 
 /** The CRC-32 (IEEE 802.3, as zlib and `rcb4 rom backup` compute it) of @p bytes. */
 function crc32(bytes) {
