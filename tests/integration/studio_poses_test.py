@@ -185,6 +185,70 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(rc == 0 and "MOV literal {04}" in out and "CONST 20 servos" in out,
               f"rcb4 motion show 11, through the studio, lists it ({rc}, {out[:300]!r} {err.strip()!r})")
 
+        # The flowchart: a motion with a button branch and a loop built by clicking and dragging:
+        # blocks added, each jump's handle dragged onto the block it goes to (a label appears there).
+        click(driver, "ed-new")
+        for kind in ("pose", "if_buttons", "pose", "loop"):
+            add(kind)
+        flow = lambda: js(driver, """return [...document.querySelectorAll('#ed-flow .flow-block')].map(
+            (g) => ({ step: Number(g.dataset.step), cls: g.getAttribute('class'), title: g.querySelector('title').textContent }));""")
+        blocks = flow()
+        bad = [b["step"] for b in blocks if " bad" in b["cls"]]
+        check(len(blocks) == 5 and bad == [1, 3],
+              f"a jump to no label is marked as it is built, not at push ({bad}: {[b['title'] for b in blocks if ' bad' in b['cls']]})")
+
+        def drag_wire(src, dst):
+            js(driver, """const svg = document.getElementById('ed-flow');
+                const exit = svg.querySelector(`.flow-exit[data-step="${arguments[0]}"]`);
+                const to = svg.querySelector(`.flow-block[data-step="${arguments[1]}"]`).getBoundingClientRect();
+                const from = exit.getBoundingClientRect();
+                const at = (x, y) => ({ bubbles: true, pointerId: 1, clientX: x, clientY: y });
+                exit.dispatchEvent(new PointerEvent('pointerdown', at(from.x + 3, from.y + 3)));
+                svg.dispatchEvent(new PointerEvent('pointermove', at(to.x + 40, to.y + 10)));
+                svg.dispatchEvent(new PointerEvent('pointerup', at(to.x + 40, to.y + 10)));""", src, dst)
+
+        drag_wire(1, 2)  # the branch: when held, on to the second pose
+        drag_wire(4, 0)  # the loop: back to the first pose (its label becomes step 0)
+        steps = js(driver, "return window.rcb4Studio.editor.doc.steps")
+        shape = [s if not (isinstance(s, dict) and "pose" in s) else "pose" for s in steps]
+        check(shape == [{"label": "L2"}, "pose", {"if_buttons": "up", "goto": "L1"}, {"label": "L1"}, "pose",
+                        {"loop": "L2"}, "end"], f"dragging the handles connected both jumps ({shape})")
+        blocks = flow()
+        warn = [b["title"].split("\n", 1)[-1] for b in blocks if " warn" in b["cls"]]
+        check(not [b for b in blocks if " bad" in b["cls"]] and any("no counter is set" in w for w in warn),
+              f"nothing dangles; the loop without a counter is marked ({warn})")
+        js(driver, "window.rcb4Studio.editor.sel = 0")
+        add("set_counter")  # after the label: inside the loop
+        warn = [b["title"].split("\n", 1)[-1] for b in flow() if " warn" in b["cls"]]
+        check(any("set again inside the loop" in w for w in warn), f"a counter set inside the loop is marked ({warn})")
+        click(driver, "ed-up")  # before the label
+        check(not [b for b in flow() if " warn" in b["cls"]], "with the counter set before the loop, nothing is marked")
+        arrows = js(driver, "return document.querySelectorAll('#ed-flow .flow-jump').length")
+        back = js(driver, "return document.querySelectorAll('#ed-flow .flow-jump.back').length")
+        check(arrows == 2 and back == 1, f"two jump arrows, the loop drawn going back ({arrows}, {back})")
+
+        # A block dragged somewhere else: moved, one undo step.
+        def block_xy(i):
+            return js(driver, """const r = document.querySelector(`#ed-flow .flow-block[data-step="${arguments[0]}"]`).getBoundingClientRect();
+                                 return [r.x, r.y];""", i)
+        x0, y0 = block_xy(2)  # the first pose
+        js(driver, """const svg = document.getElementById('ed-flow');
+            const b = svg.querySelector('.flow-block[data-step="2"]').getBoundingClientRect();
+            const at = (x, y) => ({ bubbles: true, pointerId: 1, clientX: x, clientY: y });
+            svg.dispatchEvent(new PointerEvent('pointerdown', at(b.x + 20, b.y + 10)));
+            svg.dispatchEvent(new PointerEvent('pointermove', at(b.x + 220, b.y + 40)));
+            svg.dispatchEvent(new PointerEvent('pointerup', at(b.x + 220, b.y + 40)));""")
+        x1, y1 = block_xy(2)
+        check(abs(x1 - x0 - 200) < 2 and abs(y1 - y0 - 30) < 2, f"a dragged block moves ({x1 - x0:.0f}, {y1 - y0:.0f})")
+        click(driver, "ed-undo")
+        x2, y2 = block_xy(2)
+        check(abs(x2 - x0) < 2 and abs(y2 - y0) < 2, "one Undo puts it back")
+        field("ed-slot", "13")
+        click(driver, "ed-push")
+        check(wait_until(lambda: "motion 13" in message(driver), timeout=20), f"the flowchart's motion pushed to slot 13 ({message(driver)!r})")
+        rc, out, err = run("--device", dev, "motion", "show", "13")
+        check(rc == 0 and out.count("CONST 20 servos") == 2, f"rcb4 motion show 13 lists it ({rc}, {out[:200]!r}, {err.strip()!r})")
+
         # Nothing of it moved the robot: live was off.
         after = {n: j["degrees"] for n, j in joints_on(dev).items()}
         moved = [n for n in before if abs((after[n] or 0) - (before[n] or 0)) > 0.2]

@@ -6,6 +6,7 @@
 
 import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
 import { stepForm } from './stepforms.js';
+import { createFlowchart, flowMove, flowShift } from './flowchart.js';
 import { el, $, numberIn } from './dom.js';
 
 const KINDS = {
@@ -175,6 +176,7 @@ export function createEditor(root, ctx) {
   timeline.addEventListener('pointercancel', scrubEnd);
   const detail = el('div', { id: 'ed-detail', class: 'detail' });
   const summary = el('div', { id: 'ed-summary', class: 'small muted' });
+  const flowBox = el('div', { class: 'flow-box' });
   const bt = (id, text, title, fn, cls = '') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
   root.replaceChildren(
     el('div', { class: 'row' }, name,
@@ -198,6 +200,7 @@ export function createEditor(root, ctx) {
       bt('ed-up', '↑', 'Alt+↑', () => move(-1)), bt('ed-down', '↓', 'Alt+↓', () => move(1)),
       bt('ed-undo', 'Undo', 'Ctrl+Z', undo), bt('ed-redo', 'Redo', 'Ctrl+Y', redo)),
     timeline, summary,
+    el('details', { id: 'ed-flow-panel', class: 'flow-panel', open: true }, el('summary', {}, 'Flowchart'), flowBox),
     el('div', { class: 'steps-box' }, jumps, steps),
     detail);
 
@@ -212,6 +215,8 @@ export function createEditor(root, ctx) {
   };
   function undo() { if (!ed.undo.length) return; ed.redo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.undo.pop())); render(); }
   function redo() { if (!ed.redo.length) return; ed.undo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.redo.pop())); render(); }
+  const flow = createFlowchart(flowBox, { doc: () => ed.doc, sel: () => ed.sel, select: (i) => { ed.sel = i; render(); },
+    change, kindOf, describe, say: ctx.say });
 
   // --- kept in the browser: the motion, its undo history and what was last saved survive a
   // reconnect (a restarted rcb4 ui) and a reload, per tab (sessionStorage: two tabs never
@@ -264,6 +269,7 @@ export function createEditor(root, ctx) {
     const last = ed.sel === ed.doc.steps.length - 1 && kindOf(ed.doc.steps[ed.sel]) === 'end';
     const where = last ? ed.sel : ed.sel + 1;
     ed.doc.steps.splice(where, 0, s);
+    flowShift(ed.doc, where, 1);
     ed.sel = where;
   });
   function poseAt(i) {  // the whole robot after step i: the measured angles, then every pose up to it
@@ -329,16 +335,16 @@ export function createEditor(root, ctx) {
   }
   function remove() {
     if (ed.doc.steps.length <= 1) return;
-    change(() => { ed.doc.steps.splice(ed.sel, 1); clampSel(); });
+    change(() => { ed.doc.steps.splice(ed.sel, 1); flowShift(ed.doc, ed.sel, -1); clampSel(); });
   }
   function move(d) {
     const i = ed.sel, j = i + d;
     if (j < 0 || j >= ed.doc.steps.length) return;
-    change(() => { [ed.doc.steps[i], ed.doc.steps[j]] = [ed.doc.steps[j], ed.doc.steps[i]]; ed.sel = j; });
+    change(() => { [ed.doc.steps[i], ed.doc.steps[j]] = [ed.doc.steps[j], ed.doc.steps[i]]; flowMove(ed.doc, i, j); ed.sel = j; });
   }
   function reorder(from, to) {
     if (from === to) return;
-    change(() => { const [s] = ed.doc.steps.splice(from, 1); ed.doc.steps.splice(to, 0, s); ed.sel = to; });
+    change(() => { const [s] = ed.doc.steps.splice(from, 1); ed.doc.steps.splice(to, 0, s); flowMove(ed.doc, from, to); ed.sel = to; });
   }
 
   steps.addEventListener('keydown', (e) => {
@@ -374,6 +380,7 @@ export function createEditor(root, ctx) {
       return li;
     }));
     drawJumps();
+    flow.render();
     // The timeline: each pose a block as long as its time (one pass).
     const poses = ed.doc.steps.map((s, i) => [s, i]).filter(([s]) => kindOf(s) === 'pose');
     const total = poses.reduce((a, [s]) => a + s.time_ms, 0) || 1;
@@ -512,7 +519,8 @@ export function createEditor(root, ctx) {
   function sendLive(joints) { if (ctx.controlling()) ctx.send({ op: 'move', joints }); }
 
   // --- files and slots ---
-  const text = () => JSON.stringify({ ...ed.doc, name: name.value.trim() || undefined, robot: h.robot });
+  // The motion file: the steps, not where the flowchart draws them (doc.flow stays in the editor).
+  const text = () => JSON.stringify({ ...ed.doc, flow: undefined, name: name.value.trim() || undefined, robot: h.robot });
   name.addEventListener('change', () => change(() => { ed.doc.name = name.value.trim(); }));
   function load(doc) {
     ed.undo.push(snapshot());
