@@ -210,8 +210,15 @@ TEST_CASE("measure_link: a board behind 2 ms of latency costs at least that per 
   auto c = open_client(io, b.server->where());
   c.options().baud = 1250000;
   t::error_code ec;
-  const auto cost = t::measure_link(c, ec, 5);
+  // A measurement is timing: on a loaded machine a busy spell can shorten a pair's difference
+  // (the short read waited, the long one did not), so it is measured up to five times and the
+  // link must be seen paced in one of them (an unpaced one never is: the test below).
+  auto cost = t::measure_link(c, ec, 5);
   REQUIRE_FALSE(ec);
+  for (int again = 0; again < 4 && cost.byte_time != 8800ns; ++again) {
+    cost = t::measure_link(c, ec, 5);
+    REQUIRE_FALSE(ec);
+  }
   CHECK(cost.exchange >= 2000us);   // the board never answers sooner; the wire time is not counted in it
   CHECK(cost.byte_time == 8800ns);  // 11 bits at 1.25 Mbaud
   // Behind such a link the planner reads the 20 servos' positions (+4, 20 bytes apart) in long reads.
@@ -230,20 +237,20 @@ TEST_CASE("measure_link: a board that is not paced is measured as it is, not as 
   c.options().baud = 1250000;
   t::error_code ec;
   // 126 more bytes took less than half their 1.1 ms at 1.25 Mbaud: the bytes cost what was
-  // measured. A measurement is timing: on a loaded machine one may come out slow, so it is
-  // measured up to five times, and the link must be seen unpaced in one of them (a paced link
-  // never is: the test above).
+  // measured, and so the planner merges, as it should on such a link (a read costs little more
+  // for more bytes), instead of planning 20 reads for a rate the link does not have. A
+  // measurement is timing: on a loaded machine one may come out slow, so it is measured up to
+  // five times, and the link must be seen so in one of them (a paced link never is: the test above).
+  const auto positions = khr3hv_positions();
   auto cost = t::measure_link(c, ec, 5);
   REQUIRE_FALSE(ec);
-  for (int again = 0; again < 4 && cost.byte_time >= 4400ns; ++again) {
+  for (int again = 0; again < 4 && (cost.byte_time >= 4400ns || ops::plan_reads(positions, cost).size() != 3);
+       ++again) {
     cost = t::measure_link(c, ec, 5);
     REQUIRE_FALSE(ec);
   }
   CHECK(cost.byte_time < 4400ns);
   CHECK(cost.exchange > 0ns);  // an exchange still costs something: the round trip through the pty
-  // So the planner merges, as it should on such a link (a read costs little more for more bytes),
-  // instead of planning 20 reads for a rate the link does not have.
-  const auto positions = khr3hv_positions();
   CHECK(ops::plan_reads(positions, cost).size() == 3);
 }
 

@@ -107,7 +107,8 @@ void switch_baud(basic_client<Stream>& c, std::uint32_t bps) {
 
 /**
  * Measures what a read costs on @p c: the planner's link_cost (ops::plan_reads, protocol.md §4).
- * Times @p samples 2-byte and @p samples 128-byte reads of RAM and takes the medians. The
+ * Times @p samples pairs of a 2-byte and a 128-byte read of RAM: the exchange from the short
+ * reads' median, the bytes from the median of the pairs' differences. The
  * exchange cost is what a read takes beyond its bytes' time on the wire (adapter latency, the
  * board's turnaround, the operating system): on a fast link the planner then reads joints one by
  * one, behind a millisecond of USB latency it merges them into long reads.
@@ -121,25 +122,34 @@ template <AsyncByteStream Stream>
 ops::link_cost measure_link(basic_client<Stream>& c, error_code& ec, int samples = 9) {
   const command short_read = move::read_ram(ram::config, 2).value();
   const command long_read = move::read_ram(ram::user_area, 128).value();
-  const auto median_of = [&](const command& read) {
-    std::vector<std::chrono::nanoseconds> times;
-    for (int i = 0; i < samples && !ec; ++i) {
-      const auto t0 = std::chrono::steady_clock::now();
-      c.execute(read, ec);
-      times.push_back(std::chrono::steady_clock::now() - t0);
-    }
-    if (ec || times.empty()) return std::chrono::nanoseconds{0};
-    std::nth_element(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(times.size() / 2), times.end());
-    return times[times.size() / 2];
+  // Short and long reads alternate, and the long read's extra time is the median of each pair's
+  // difference: load that comes and goes (another program, a sanitizer's work) then falls on both
+  // reads of a pair alike, where timing all short reads and then all long ones let a busy spell in
+  // one phase look like a faster or slower line.
+  const auto median = [](std::vector<std::chrono::nanoseconds>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  const auto timed = [&](const command& read) {
+    const auto t0 = std::chrono::steady_clock::now();
+    c.execute(read, ec);
+    return std::chrono::nanoseconds(std::chrono::steady_clock::now() - t0);
   };
   c.execute(short_read, ec);  // the first exchange may pay for a cold path; it is not counted
   if (ec) return {};
-  const auto t_short = median_of(short_read);
-  const auto t_long = median_of(long_read);
-  if (ec || samples <= 0) return {};
+  std::vector<std::chrono::nanoseconds> shorts, extra;
+  for (int i = 0; i < samples && !ec; ++i) {
+    const auto t_short = timed(short_read);
+    if (ec) break;
+    const auto t_long = timed(long_read);
+    shorts.push_back(t_short);
+    extra.push_back(t_long - t_short);
+  }
+  if (ec || shorts.empty()) return {};
+  const auto t_short = median(shorts);
   const auto baud = c.options().baud > 0 ? c.options().baud : 115200u;
   auto cost = ops::link_cost::at(baud, {});
-  const auto per_byte = std::max(t_long - t_short, std::chrono::nanoseconds(0)) / 126;
+  const auto per_byte = std::max(median(extra), std::chrono::nanoseconds(0)) / 126;
   if (per_byte * 2 < cost.byte_time) cost.byte_time = per_byte;  // not paced at its rate
   cost.exchange = std::max(t_short - cost.byte_time * 15, std::chrono::nanoseconds(0));
   return cost;
