@@ -3,7 +3,7 @@
 # the asked rate with every joint, a trajectory that moves left_knee (checked through the rcb4 tool
 # once the node has let the board go), a point beyond a limit or due at once that moves nothing,
 # stop and ~stop holding where the joint is, free and hold,
-# SIGINT within 1 s; then on a board of our own that falls silent: diagnostics ERROR and no stale
+# SIGINT and SIGTERM ending it within 1 s with exit 0; then on a board of our own that falls silent: diagnostics ERROR and no stale
 # joint_states until it answers again.
 #   node_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR
 # SPDX-License-Identifier: BSL-1.0
@@ -46,9 +46,9 @@ def start_node(*params):
                             text=True)
 
 
-def stop(node):
+def stop(node, sig=signal.SIGINT):
     sent = time.monotonic()
-    node.send_signal(signal.SIGINT)
+    node.send_signal(sig)
     try:
         node.wait(timeout=5)
     except subprocess.TimeoutExpired:
@@ -203,7 +203,9 @@ try:
     check(r1.success and r2.success and "20 joints" in r2.message, f"~hold and ~free answer ({r1.message!r}, {r2.message!r})")
     took = stop(node)
     out = node.stdout.read()
-    check(node.returncode is not None and took < 1.0, f"SIGINT ends the node within 1 s ({took:.2f} s)")
+    # 1 s is the documented bound, generous: measured 16-33 ms, 40-140 ms at load average 11 (docs/ros.md).
+    check(node.returncode == 0 and took < 1.0, f"SIGINT ends the node within 1 s, exit 0 ({node.returncode}, "
+                                               f"{took:.3f} s)")
     check("beyond its upper limit 130" in out, "the refused trajectory is logged with the joint and the limit")
     check("motion 3 is running on the board" in out, "the trajectory refused under motion 3 is logged")
     check("every point is due at once" in out, "the trajectory whose point is due at once is logged")
@@ -316,8 +318,10 @@ try:
     rospy.delete_param("/rcb4/device")  # the runs before left theirs on the parameter server
     node = start_node()
     check(wait_for(lambda: len(states) > 3, timeout=15), "no ~device: joint_states")
-    stop(node)
+    took = stop(node, signal.SIGTERM)
     out = node.stdout.read()
+    check(node.returncode == 0 and took < 1.0, f"SIGTERM ends the node within 1 s, exit 0 ({node.returncode}, "
+                                               f"{took:.3f} s)")
     check("the in-process virtual board, a simulation, not a robot" in out,
           f"no ~device: a warning that it is the virtual board ({out.strip()[:300]!r})")
     node = start_node("_timeout:=abc")
