@@ -4,9 +4,13 @@
 # tolerance, INVALID_JOINTS and INVALID_GOAL with nothing moved (a point due at once too), cancel and
 # preemption holding the joints, a ROM motion refusing the goal), kxr_controller's ServoOnOff
 # (a mimic joint's servo, unknown names left out), Stretch and AdjustAngleVector (a threshold that
-# looks like radians said), the joints parameter and robot_description; on a board of our own
-# whose servos never move, PATH_TOLERANCE_VIOLATED and an adjustment; a script written as a
-# kxr_controller user writes it, run unchanged. interrupts_test.py: a silent board, takeovers.
+# looks like radians said), the joints parameter and robot_description; the topics a kxr_controller
+# user reads (current_joint_states, servo_states, fullbody_controller/state and ServoOnOff's state:
+# the servo error, NaN for what is not known); on a board of our own whose servos never move,
+# PATH_TOLERANCE_VIOLATED,
+# an adjustment, the servo error of a servo that does not follow, and nothing published while that
+# board is silent; a script written as a kxr_controller user writes it, run unchanged.
+# interrupts_test.py: a silent board, takeovers.
 #   actions_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR MESSAGES_DIR
 # SPDX-License-Identifier: BSL-1.0
 import json
@@ -37,8 +41,10 @@ import rospy  # noqa: E402
 from actionlib_msgs.msg import GoalStatus  # noqa: E402
 from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryGoal, JointTolerance  # noqa: E402
 from control_msgs.msg import FollowJointTrajectoryResult as Result  # noqa: E402
+from control_msgs.msg import JointTrajectoryControllerState  # noqa: E402
 from kxr_controller.msg import AdjustAngleVectorAction, AdjustAngleVectorGoal  # noqa: E402
-from kxr_controller.msg import ServoOnOffAction, ServoOnOffGoal, Stretch, StretchAction, StretchGoal  # noqa: E402
+from kxr_controller.msg import ServoOnOff, ServoOnOffAction, ServoOnOffGoal, ServoStateArray  # noqa: E402
+from kxr_controller.msg import Stretch, StretchAction, StretchGoal  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import UInt8  # noqa: E402
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E402
@@ -46,6 +52,32 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint  # noqa: E
 rospy.init_node("rcb4_actions_test", anonymous=True, disable_signals=True)
 states = []
 rospy.Subscriber("/joint_states", JointState, lambda m: states.append(m), queue_size=100)
+# What a kxr_controller user reads besides joint_states: (monotonic time received, message).
+READINGS = {"/current_joint_states": JointState, "/servo_states": ServoStateArray,
+            "/fullbody_controller/state": JointTrajectoryControllerState,
+            "/fullbody_controller/servo_on_off_real_interface/state": ServoOnOff}
+readings = {topic: [] for topic in READINGS}
+for topic, kind in READINGS.items():
+    rospy.Subscriber(topic, kind, lambda m, t=topic: readings[t].append((time.monotonic(), m)), queue_size=100)
+
+
+def latest(topic, timeout=5):
+    """The newest message on @p topic received from now on (None when none comes within @p timeout s)."""
+    since = time.monotonic()
+    got = wait_for(lambda: [m for t, m in readings[topic][-5:] if t >= since], timeout=timeout)
+    return got[-1] if got else None
+
+
+def value_of(msg, name, field=None):
+    """@p msg's value for joint @p name (a JointState's position/effort, a controller state's
+    desired/actual/error positions, a ServoStateArray's ServoState), or None when it is not there."""
+    if isinstance(msg, ServoStateArray):
+        return next((s for s in msg.servos if s.name == name), None)
+    names = msg.name if isinstance(msg, JointState) else msg.joint_names
+    if name not in names:
+        return None
+    values = getattr(msg, field) if isinstance(msg, JointState) else getattr(msg, field).positions
+    return values[names.index(name)]
 
 
 def position(name):
@@ -113,6 +145,28 @@ try:
     check(len(feedback) > 20 and feedback[-1].joint_names == ["left_knee"]
           and abs(math.degrees(feedback[len(feedback) // 2].desired.positions[0]) - 20) < 8,
           f"feedback at the control rate: desired, actual, error ({len(feedback)} messages)")
+    # The readings a kxr_controller user takes: left_knee's target is known (40, where the goal put
+    # it), head_yaw's is not (never commanded): its error is NaN, not a made-up 0.
+    js, cur, servos, ctl = (states[-1], latest("/current_joint_states"), latest("/servo_states"),
+                            latest("/fullbody_controller/state"))
+    knee = value_of(servos, "left_knee") if servos else None
+    check(len(js.effort) == len(js.name) == 20 and abs(value_of(js, "left_knee", "effort")) < math.radians(0.5)
+          and math.isnan(value_of(js, "head_yaw", "effort")) and not js.velocity,
+          f"joint_states: effort is the servo error (left_knee at its target: {value_of(js, 'left_knee', 'effort')}; "
+          f"head_yaw's target unknown: {value_of(js, 'head_yaw', 'effort')}), no velocities ({len(js.velocity)})")
+    check(cur is not None and len(cur.name) == 20 and abs(math.degrees(value_of(cur, "left_knee", "position")) - 40) < 1
+          and len(cur.effort) == 20, f"current_joint_states: the servos' joints, positions and errors "
+                                     f"({cur and len(cur.name)})")
+    check(knee is not None and len(servos.servos) == 20 and abs(math.degrees(knee.position) - 40) < 1
+          and abs(knee.error) < math.radians(0.5) and math.isnan(knee.temperature) and math.isnan(knee.current)
+          and math.isnan(value_of(servos, "head_yaw").error),
+          f"servo_states: position and error; temperature and current NaN (the RCB-4 reads neither) "
+          f"({knee and (knee.position, knee.error, knee.temperature, knee.current)})")
+    check(ctl is not None and len(ctl.joint_names) == 20 and abs(math.degrees(value_of(ctl, "left_knee", "desired")) - 40) < 0.1
+          and abs(value_of(ctl, "left_knee", "error")) < math.radians(0.5) and math.isnan(value_of(ctl, "head_yaw", "desired"))
+          and not ctl.actual.velocities,
+          f"fullbody_controller/state: desired, actual, error; head_yaw's desired unknown (NaN) "
+          f"({ctl and (ctl.desired.positions[:3], ctl.error.positions[:3])})")
     # Two joints, two points.
     client.send_goal(goal([([10, 20], 0.4), ([-10, 0], 0.8)], joints=("left_knee", "head_yaw")))
     client.wait_for_result(rospy.Duration(10))
@@ -176,6 +230,13 @@ try:
     on_off.send_goal(ServoOnOffGoal(joint_names=["left_knee"], servo_on_states=[False]))
     on_off.wait_for_result(rospy.Duration(5))
     check(on_off.get_state() == GoalStatus.SUCCEEDED, f"ServoOnOff frees left_knee ({on_off.get_goal_status_text()!r})")
+    servo_on = latest("/fullbody_controller/servo_on_off_real_interface/state")
+    ctl = latest("/fullbody_controller/state")
+    check(servo_on is not None and len(servo_on.joint_names) == 20
+          and dict(zip(servo_on.joint_names, servo_on.servo_on_states)) == {n: n != "left_knee" for n in joints}
+          and math.isnan(value_of(ctl, "left_knee", "desired")),
+          f"servo_on_off_real_interface/state: left_knee off, the others on; a free joint has no target "
+          f"({servo_on and [n for n, on in zip(servo_on.joint_names, servo_on.servo_on_states) if not on]})")
     on_off.send_goal(ServoOnOffGoal(joint_names=["no_such_joint"], servo_on_states=[True]))
     on_off.wait_for_result(rospy.Duration(5))
     check(on_off.get_state() == GoalStatus.ABORTED and "no_such_joint" in on_off.get_goal_status_text(),
@@ -310,6 +371,29 @@ try:
           and client.get_state() in (GoalStatus.ABORTED, GoalStatus.PREEMPTED),
           f"AdjustAngleVector holds the lagging joint and ends the goal ({adjust.get_goal_status_text()!r}, "
           f"{client.get_state()})")
+    # A servo that does not follow: its error is where the board has it go (30 deg) minus where it is (0).
+    cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2)
+    wait_for(lambda: cmd.get_num_connections() > 0)
+    cmd.publish(JointTrajectory(joint_names=["head_yaw"], points=[
+        JointTrajectoryPoint(positions=[math.radians(30)], time_from_start=rospy.Duration(0.3))]))
+    time.sleep(0.8)
+    js, servos, ctl = states[-1], latest("/servo_states"), latest("/fullbody_controller/state")
+    errors = [math.degrees(e) for e in (value_of(js, "head_yaw", "effort"), servos and value_of(servos, "head_yaw").error,
+                                        ctl and value_of(ctl, "head_yaw", "error")) if e is not None]
+    check(len(js.name) == 3 and abs(value_of(js, "head_yaw", "position")) < 1e-9 and len(errors) == 3
+          and all(abs(e - 30) < 0.5 for e in errors),
+          f"a servo that stays at 0 while the board has it at 30: its error is 30 deg in joint_states' effort, "
+          f"servo_states and fullbody_controller/state ({errors})")
+    # The board falls silent: nothing new on any of them until it answers again.
+    board.silent = True
+    time.sleep(1.0)  # its reads time out (3 x 0.1 s): from here on nothing is read
+    counts = [len(states)] + [len(readings[t]) for t in READINGS]
+    time.sleep(1.0)
+    still = [len(states)] + [len(readings[t]) for t in READINGS]
+    board.silent = False
+    again = wait_for(lambda: all(len(x) > n for x, n in zip([states] + list(readings.values()), still)), timeout=5)
+    check(counts == still and again, f"a silent board: nothing published on joint_states, {', '.join(READINGS)} "
+                                     f"for 1 s ({counts} then {still}); published again once it answers")
 finally:
     stop(node)
 # A servo that never answers (serve --silent 16: left_knee) is not within any tolerance.

@@ -34,6 +34,12 @@ PUBLISHED = {
     "kxr_controller/Stretch": "9b2b730aeb11dca161b5a118a2171acb",
     "kxr_controller/StretchGoal": "c548d78132f076011af76f4175ffa5b0",
     "kxr_controller/AdjustAngleVectorGoal": "cf618411b2b5e77c4c269ff22a27ed58",
+    # servo_states: ServoStateArray's is the published one (it covers ServoState's text); ServoState's
+    # and ServoOnOff's (the fullbody_controller/servo_on_off_real_interface/state message) are what
+    # genpy gives iory/rcb4's own .msg files.
+    "kxr_controller/ServoStateArray": "c49987abc073bf0afcf190de7df7c47c",
+    "kxr_controller/ServoState": "ce152110c70fb30775e21de46928de76",
+    "kxr_controller/ServoOnOff": "29bb8c289c7a237569042d21176cbdd5",
 }
 
 for full, md5 in PUBLISHED.items():

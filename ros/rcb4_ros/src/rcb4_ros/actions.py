@@ -155,9 +155,14 @@ class Actions(FollowTrajectory):
         return self.adjust.set_succeeded(result, message + note)
 
 
+def namespace():
+    """Where kxr_controller's fullbody_controller is: ~controller_namespace, in the node's namespace."""
+    return rospy.get_param("~controller_namespace", "fullbody_controller")
+
+
 def start(node):
     """The action servers for @p node, or None (said) when the messages are not to be had."""
-    ns = rospy.get_param("~controller_namespace", "fullbody_controller")
+    ns = namespace()
     rospy.set_param(ns + "/joints", [node.prefix + n for n in node.names])  # before a client sees a server
     try:
         actions = Actions(node, ns)

@@ -26,9 +26,10 @@ import pyrcb4
 from rcb4_ros import actions
 from rcb4_ros.holds import Holds
 from rcb4_ros.requests import Requests
+from rcb4_ros.states import States
 from rcb4_ros.trajectory import Trajectories
 
-class Rcb4Node(Trajectories, Requests, Holds):
+class Rcb4Node(Trajectories, Requests, Holds, States):
     """The node: parameters ~device (empty: the in-process virtual board), ~baud, ~robot, ~rate
     (default: one cycle per board output period), ~joint_prefix, ~timeout."""
 
@@ -85,7 +86,7 @@ class Rcb4Node(Trajectories, Requests, Holds):
         self.rate_window = (time.monotonic(), 0)
         self.cycles_per_s = 0.0
         self.last_motion = None
-        self.states = rospy.Publisher("joint_states", JointState, queue_size=10)
+        self.init_states()  # joint_states and the other readings (states.py)
         self.motion_pub = rospy.Publisher("~motion", String, queue_size=2, latch=True)
         self.sensors_pub = rospy.Publisher("~sensors", String, queue_size=2)
         self.battery_pub = rospy.Publisher("~battery", BatteryState, queue_size=2)
@@ -137,18 +138,7 @@ class Rcb4Node(Trajectories, Requests, Holds):
             self.carry_out()
             self.write_due()
         self.loop.read(out=self.angles)
-        stamp = rospy.Time.now()
-        msg = JointState()
-        msg.header.stamp = stamp
-        for name, deg in zip(self.names, self.angles):
-            if not math.isnan(deg):  # a servo that does not answer is left out, never made up
-                msg.name.append(self.prefix + name)
-                msg.position.append(math.radians(deg))
-        for name, j, k, off in self.mimics:
-            if not math.isnan(self.angles[j]):
-                msg.name.append(name)
-                msg.position.append(math.radians(k * self.angles[j] + off))
-        self.states.publish(msg)
+        self.publish_states(rospy.Time.now(), time.monotonic())  # a servo that does not answer is left out
         self.cycles += 1
 
     def slow_things(self):
@@ -159,6 +149,8 @@ class Rcb4Node(Trajectories, Requests, Holds):
         if st != self.last_motion:
             self.motion_pub.publish(String(json.dumps(st)))
             self.last_motion = st
+        if pyrcb4.move_refusal(st):  # a ROM motion moves the servos: the node's last moves say nothing of them
+            self.moves.clear()
         s = self.board.sensors()
         self.sensors_pub.publish(String(json.dumps(
             {"battery_volts": s["battery_volts"], "ad_volts": s["ad_volts"], "buttons": s["button_names"]})))
@@ -187,6 +179,7 @@ class Rcb4Node(Trajectories, Requests, Holds):
             return
         self.board, self.released, self.where = board, False, board.where
         self.loop = self.board.control_loop()
+        self.moves.clear()  # what the node sent went to the board that went away
         self.read_freed()  # the board that answers now may not be the one whose joints were freed
         self.reopen_at = None
         rospy.loginfo("rcb4: %s opened again", self.device)

@@ -73,9 +73,11 @@ class Requests:
                         message += f" (what was under way for {', '.join(dropped)} is dropped)"
                         rospy.logwarn("rcb4: %s", message)
                 elif what == "resume":
+                    self.moves.clear()  # the ROM program moves the servos from here
                     self.board.resume_motion()
                     message = "the ROM program runs again"
                 elif what == "play":
+                    self.moves.clear()
                     self.board.play_motion(int(argument), wait=False)
                     message = f"playing motion {argument}"
                 elif what == "stop":
