@@ -29,7 +29,8 @@ packages=(
   pybind11-dev python3-dev python3-pytest python3-numpy python3-serial  # pyrcb4, its tests, its benchmark
   python3-rospy python3-rosmaster python3-rostopic python3-sensor-msgs python3-trajectory-msgs \
   python3-std-srvs python3-std-msgs python3-diagnostic-msgs python3-rosservice python3-rosnode python3-roslaunch \
-  python3-actionlib python3-actionlib-msgs python3-genpy python3-genmsg  # rcb4_ros: ROS 1's Python side only (its C++ packages would remove libboost1.81-dev); genpy generates the messages Debian lacks
+  python3-actionlib python3-actionlib-msgs python3-genpy python3-genmsg \
+  python3-dynamic-reconfigure  # rcb4_ros: ROS 1's Python side only (its C++ packages would remove libboost1.81-dev); genpy generates the messages Debian lacks; dynamic_reconfigure's Python server (kxr_controller's parameters)
 )
 
 if [ "${1:-}" = --list ]; then

@@ -6,11 +6,12 @@
 # (a mimic joint's servo, unknown names left out), Stretch and AdjustAngleVector (a threshold that
 # looks like radians said), the joints parameter and robot_description; the topics a kxr_controller
 # user reads (current_joint_states, servo_states, fullbody_controller/state and ServoOnOff's state:
-# the servo error, NaN for what is not known); on a board of our own whose servos never move,
-# PATH_TOLERANCE_VIOLATED,
-# an adjustment, the servo error of a servo that does not follow, and nothing published while that
-# board is silent; a script written as a kxr_controller user writes it, run unchanged.
-# interrupts_test.py: a silent board, takeovers.
+# the servo error, NaN for what is not known) and its dynamic_reconfigure parameters (frame_count
+# acting on a streamed command; a value out of range, the current limit and a start-up
+# ~current_limit refused, said); on a board of our own whose servos never move,
+# PATH_TOLERANCE_VIOLATED, an adjustment, the servo error of a servo that does not follow, and
+# nothing published while that board is silent; a script written as a kxr_controller user writes
+# it, run unchanged. interrupts_test.py: a silent board, takeovers.
 #   actions_test.py RCB4 PYRCB4_DIR NODE_SRC_DIR MESSAGES_DIR
 # SPDX-License-Identifier: BSL-1.0
 import json
@@ -37,6 +38,7 @@ env["RCB4_ROS_MESSAGES"] = MESSAGES
 sys.path.append(MESSAGES)
 
 import actionlib  # noqa: E402
+import dynamic_reconfigure.client  # noqa: E402
 import rospy  # noqa: E402
 from actionlib_msgs.msg import GoalStatus  # noqa: E402
 from control_msgs.msg import FollowJointTrajectoryAction, FollowJointTrajectoryGoal, JointTolerance  # noqa: E402
@@ -123,7 +125,8 @@ def tool_joints(dev):
 
 srv = subprocess.Popen([RCB4, "serve", "--pty"], stdout=subprocess.PIPE, text=True)
 dev = srv.stdout.readline().strip()
-node = start_node(f"_device:={dev}", "_rate:=50")
+# ~current_limit, as kxr_controller.launch sets it: the RCB-4 cannot apply it (refused at start, said).
+node = start_node(f"_device:={dev}", "_rate:=50", "_current_limit:=4.0")
 try:
     client = actionlib.SimpleActionClient("/fullbody_controller/follow_joint_trajectory", FollowJointTrajectoryAction)
     check(client.wait_for_server(rospy.Duration(20)), "the FollowJointTrajectory server is up")
@@ -299,6 +302,34 @@ try:
     check(r.returncode == 0 and "result 3 0" in r.stdout and abs(position("left_knee") - math.degrees(0.1)) < 1,
           f"a kxr_controller user's script runs unchanged: every servo on, all joints to 0.1 rad ({r.stdout.strip()!r} "
           f"{r.stderr.strip()[-300:]!r})")
+    # kxr_controller's dynamic_reconfigure parameters, through its client's way of reaching them
+    # (update_kxr_parameters: Client("rcb4_ros_bridge")).
+    params = dynamic_reconfigure.client.Client("rcb4_ros_bridge", timeout=10)
+    cfg = params.get_configuration(timeout=5)
+    check(cfg["frame_count"] == 2 and cfg["wheel_frame_count"] == 1 and math.isnan(cfg["current_limit"])
+          and math.isnan(cfg["temperature_limit"]),
+          f"dynamic_reconfigure: frame_count one cycle (2 frames at 50 Hz), the limits NaN (not known) "
+          f"({ {k: v for k, v in cfg.items() if k != 'groups'} })")
+    r = params.update_configuration({"frame_count": 100})
+    stream = rospy.Publisher("/rcb4/joint_command", JointState, queue_size=2)
+    wait_for(lambda: stream.get_num_connections() > 0)
+    sent = time.monotonic()
+    stream.publish(JointState(name=["left_knee"], position=[math.radians(45)]))  # from 0.1 rad (5.7 deg)
+    time.sleep(max(0.0, sent + 0.5 - time.monotonic()))
+    half = position("left_knee")
+    arrived = wait_for(lambda: abs(position("left_knee") - 45) < 1, timeout=5)
+    check(r["frame_count"] == 100 and 10 < half < 40 and arrived,
+          f"frame_count 100: a streamed target is a 1 s move (left_knee {half:.1f} deg 0.5 s after it, on its "
+          f"way from 5.7 to 45)")
+    r = params.update_configuration({"frame_count": 300})
+    r2 = params.update_configuration({"current_limit": 3.0, "temperature_limit": 70.0})
+    check(r["frame_count"] == 100 and math.isnan(r2["current_limit"]) and math.isnan(r2["temperature_limit"]),
+          f"frame_count 300 (beyond 255) refused, it stays 100; current and temperature limits refused, NaN "
+          f"({r['frame_count']}, {r2['current_limit']}, {r2['temperature_limit']})")
+    params.update_configuration({"frame_count": 2})
+    stream.publish(JointState(name=["left_knee"], position=[0.1]))
+    check(wait_for(lambda: abs(position("left_knee") - math.degrees(0.1)) < 1, timeout=5) is not None,
+          f"frame_count 2 again: left_knee back at 0.1 rad ({position('left_knee')})")
     # A ~command for another joint takes over: the goal is preempted, its joints hold (they do not
     # run on to the end of a goal nobody watches any more).
     cmd = rospy.Publisher("/rcb4/command", JointTrajectory, queue_size=2)
@@ -340,6 +371,11 @@ check(j.get("left_knee", {}).get("state") == "free" and abs(j["left_knee"]["degr
       f"rcb4 joint list after the node: the joints where the goal put them (0.1 rad), left_knee free ({j.get('left_knee')})")
 check("follow_joint_trajectory: refused, nothing moves: no joint is called 'no_such_joint'" in first_out,
       "a refused goal is logged with its reason")
+check("~current_limit 4.0 refused: the RCB-4 can neither set nor read" in first_out
+      and "frame_count 100: each ~joint_command target is a move of 100 frames (1000 ms)" in first_out
+      and "frame_count 300 is outside 1-255: refused, it stays 100" in first_out
+      and "current_limit 3.0 refused" in first_out and "temperature_limit 70.0 refused" in first_out,
+      "dynamic_reconfigure: what is applied and what is refused is logged")
 srv.terminate()
 srv.wait(timeout=10)
 

@@ -328,6 +328,11 @@ try:
     out, _ = node.communicate(timeout=30)
     check(node.returncode == 1 and "~timeout: 'abc' is not a number of seconds" in out,
           f"_timeout:=abc: exit 1 naming it ({node.returncode}, {out.strip()[-120:]!r})")
+    rospy.delete_param("/rcb4/timeout")  # the run before left it on the parameter server
+    node = start_node("_frame_count:=300")
+    out, _ = node.communicate(timeout=30)
+    check(node.returncode == 1 and "~frame_count: 300 frames: a move takes 1-255 frames" in out,
+          f"_frame_count:=300: exit 1 naming it ({node.returncode}, {out.strip()[-120:]!r})")
 finally:
     rospy.signal_shutdown("done")
     master.terminate()

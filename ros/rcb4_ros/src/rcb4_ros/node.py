@@ -23,7 +23,7 @@ from std_srvs.srv import Trigger
 from trajectory_msgs.msg import JointTrajectory
 
 import pyrcb4
-from rcb4_ros import actions
+from rcb4_ros import actions, reconfigure
 from rcb4_ros.holds import Holds
 from rcb4_ros.requests import Requests
 from rcb4_ros.states import States
@@ -31,7 +31,8 @@ from rcb4_ros.trajectory import Trajectories
 
 class Rcb4Node(Trajectories, Requests, Holds, States):
     """The node: parameters ~device (empty: the in-process virtual board), ~baud, ~robot, ~rate
-    (default: one cycle per board output period), ~joint_prefix, ~timeout."""
+    (default: one cycle per board output period), ~joint_prefix, ~timeout, ~frame_count (the frames
+    of each ~joint_command target's move; default: one cycle's worth)."""
 
     def __init__(self):
         device = rospy.get_param("~device", None)
@@ -56,6 +57,10 @@ class Rcb4Node(Trajectories, Requests, Holds, States):
             raise ValueError(f"~rate: {rospy.get_param('~rate')!r} is not a number of Hz") from None
         if not 0 < self.rate <= 1000:
             raise ValueError(f"~rate: {self.rate:g} Hz: it must be above 0 and at most 1000")
+        # The frames of the move each ~joint_command target becomes (kxr_controller's frame_count;
+        # dynamic_reconfigure changes it: reconfigure.py): by default one cycle's worth.
+        self.frame_count = reconfigure.frame_count_of(
+            rospy.get_param("~frame_count", min(255, max(1, round(1.0 / self.rate / self.period)))))
         self.reopen_at = None  # when the device went away: the next time to open it again
         self.released = False  # the dead device closed, a new one not yet open
         self.where = self.board.where
@@ -105,6 +110,7 @@ class Rcb4Node(Trajectories, Requests, Holds, States):
                       self.rate, self.period * 1000)
         self.describe_robot()
         self.actions = actions.start(self)
+        self.reconfigure = reconfigure.start(self)
 
     def describe_robot(self):
         """robot_description from the profile's kinematics (rcb4 urdf), unless one is set already."""

@@ -234,7 +234,7 @@ class Trajectories:
                 frames = max(1, round((at + frames * self.period - now) / self.period))
             self.write(targets, frames, now)
         elif stream is not None:
-            self.write(stream, max(1, round(1.0 / self.rate / self.period)), now)
+            self.write(stream, self.frame_count, now)  # kxr_controller's frame_count (reconfigure.py)
 
     def write(self, targets, frames, now):
         """Sends a move; one the board refuses (a joint with no servo on it) is dropped and said, with
