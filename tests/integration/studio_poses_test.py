@@ -5,11 +5,13 @@
 # robot/mirror.hpp works out from the body); a limb copied onto the other; Home; a joint "as in the
 # pose before"; a pose copied in one tab and pasted in another tab's motion; undo after each; and
 # with "live on the robot" off, none of it moves the robot (read through the studio's share).
-# Usage: studio_poses_test.py RCB4
+# Usage: studio_poses_test.py RCB4 [SCREENSHOT_DIR]
 # SPDX-License-Identifier: BSL-1.0
 import json
+import os
 import sys
 import tempfile
+import time
 
 from checks import check, finish
 from uihelp import tools
@@ -248,6 +250,33 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: "motion 13" in message(driver), timeout=20), f"the flowchart's motion pushed to slot 13 ({message(driver)!r})")
         rc, out, err = run("--device", dev, "motion", "show", "13")
         check(rc == 0 and out.count("CONST 20 servos") == 2, f"rcb4 motion show 13 lists it ({rc}, {out[:200]!r}, {err.strip()!r})")
+
+        # Layout: at three common screen sizes the robot and the pose being edited are seen
+        # together (the robot's panel stays under the header while the editor scrolls).
+        js(driver, "window.rcb4Studio.editor.sel = 2")
+        for w, h in ((1366, 768), (1600, 1000), (1920, 1080)):
+            driver.set_window_size(w, h)
+            time.sleep(0.6)  # the view resizes to the window
+            seen = js(driver, """const detail = document.querySelector('#ed-detail');
+                const panel = document.querySelector('.studio > .panel').getBoundingClientRect();
+                window.scrollBy(0, detail.getBoundingClientRect().top - panel.bottom - 4);  // the pose just below the robot
+                const rows = [...detail.querySelectorAll('.pose-joint')].filter((x) => {
+                  const b = x.getBoundingClientRect();
+                  return b.top >= 0 && b.bottom <= Math.min(innerHeight, x.parentElement.getBoundingClientRect().bottom); });
+                const row = detail.querySelector('.pose-joint');
+                const v = document.querySelector('#view3d canvas').getBoundingClientRect();
+                const r = row.getBoundingClientRect();
+                const top = document.elementFromPoint(v.x + v.width / 2, v.y + v.height / 2);
+                const slider = row.querySelector('input[type=range]').getBoundingClientRect();
+                const hit = document.elementFromPoint(slider.x + slider.width / 2, slider.y + slider.height / 2);
+                return { view: v.top >= 0 && v.bottom <= innerHeight && top && top.tagName === 'CANVAS',
+                         pose: r.top >= 0 && r.bottom <= innerHeight && hit && hit.type === 'range',
+                         rows: rows.length, v: [v.top, v.bottom], r: [r.top, r.bottom], h: innerHeight };""")
+            check(seen["view"] and seen["pose"] and seen["rows"] >= 4,
+                  f"at {w}x{h} the robot and the pose's sliders are both in view, neither covered ({seen})")
+            if len(sys.argv) > 2:
+                driver.save_screenshot(os.path.join(sys.argv[2], f"rcb4-studio-{w}x{h}.png"))
+        driver.set_window_size(1400, 1080)
 
         # Nothing of it moved the robot: live was off.
         after = {n: j["degrees"] for n, j in joints_on(dev).items()}

@@ -440,4 +440,8 @@ function wire() {
 }
 
 wire();
+// The robot's panel sticks below the header (style.css), whose height depends on the window.
+const headerHeight = () => document.documentElement.style.setProperty('--header-h', `${$('header').offsetHeight}px`);
+window.addEventListener('resize', headerHeight);
+headerHeight();
 connect();

@@ -200,9 +200,9 @@ export function createEditor(root, ctx) {
       bt('ed-up', '↑', 'Alt+↑', () => move(-1)), bt('ed-down', '↓', 'Alt+↓', () => move(1)),
       bt('ed-undo', 'Undo', 'Ctrl+Z', undo), bt('ed-redo', 'Redo', 'Ctrl+Y', redo)),
     timeline, summary,
+    detail,  // the step being edited first, in view with the robot (the list and flowchart below)
     el('details', { id: 'ed-flow-panel', class: 'flow-panel', open: true }, el('summary', {}, 'Flowchart'), flowBox),
-    el('div', { class: 'steps-box' }, jumps, steps),
-    detail);
+    el('div', { class: 'steps-box' }, jumps, steps));
 
   // --- history ---
   const snapshot = () => JSON.stringify({ doc: ed.doc, sel: ed.sel });

@@ -116,7 +116,10 @@ export async function createView(box, hello, opts = {}) {
   const stats = { frames: 0, started: performance.now() };
   let shown = [0, 0];
   const resize = () => {
-    const w = box.clientWidth || 400, h = Math.min(520, Math.max(260, Math.round(w * 0.7)));
+    // As wide as its column, and short enough that the pose being edited fits below it in the
+    // window (the view stays at the top while the editor scrolls: style.css).
+    const w = box.clientWidth || 400;
+    const h = Math.max(200, Math.min(520, Math.round(w * 0.7), Math.round(window.innerHeight * 0.42)));
     if (w === shown[0] && h === shown[1]) return;  // a resize that changes nothing redraws nothing
     shown = [w, h];
     renderer.setSize(w, h, false);
@@ -139,6 +142,7 @@ export async function createView(box, hello, opts = {}) {
     requestAnimationFrame(frame);
   };
   new ResizeObserver(() => { resize(); invalidate(); }).observe(box);
+  window.addEventListener('resize', () => { resize(); invalidate(); });  // a taller or shorter window
   resize();
   controls.addEventListener('change', invalidate);
   invalidate();
