@@ -34,6 +34,7 @@ def share_path(dev):
 
 
 with serve() as dev, tempfile.TemporaryDirectory() as poses:
+    os.environ["RCB4_SLOT_NAMES"] = os.path.join(poses, "slot-names.yaml")  # not the user's own
     rc, out, err = run("--device", dev, "ping")
     check(rc == 0, f"before the studio: ping on the port itself ({rc}, {err.strip()!r})")
     ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)

@@ -43,6 +43,7 @@ def message(driver):
 
 
 with serve() as dev, tempfile.TemporaryDirectory() as poses:
+    os.environ["RCB4_SLOT_NAMES"] = os.path.join(poses, "slot-names.yaml")  # not the user's own
     ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
     driver = browser()
     try:
