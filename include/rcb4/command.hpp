@@ -68,6 +68,17 @@ constexpr request_frame encode(const C& c) noexcept {
   return f;
 }
 
+/**
+ * A result of make() is no command: encode(C::make(...)) does not compile, and says why (check
+ * the result, then take .value(); or give the command's values as constants).
+ */
+template <class C>
+constexpr request_frame encode(const result<C>&) noexcept {
+  static_assert(detail::always_false<C>,
+                "rcb4: encode() takes a command, not the result of make(): check it (has_value()), then .value()");
+  return {};
+}
+
 /** Frame length of commands whose length never varies; 0 for the others. */
 template <class C>
 inline constexpr std::size_t fixed_wire_size = 0;

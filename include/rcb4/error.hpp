@@ -12,6 +12,8 @@ namespace rcb4 {
  * Everything the codec can reject. Zero is "no error"; every other value has a message
  * (see message()). constexpr code uses the enum directly; std::error_code interop is below.
  */
+// A new code gets its line in result.hpp's detail::result_holds_error and bad_result_access()
+// too (-Wswitch names a code missing there), so that a constant expression names it.
 enum class errc : std::uint8_t {
   // framing (protocol.md §2)
   buffer_too_small = 1,  ///< the caller's output buffer cannot hold the frame

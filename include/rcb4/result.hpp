@@ -12,6 +12,109 @@ namespace detail {
 /// Deliberately not constexpr: reaching it in a constant expression is a compile error
 /// naming the problem; at run time it traps (no exceptions needed in firmware).
 inline void bad_result_access() noexcept { __builtin_trap(); }
+
+/// One function per error, none constexpr: value() of a failed result in a constant expression
+/// stops the compiler at the one that names the error held ("call to non-constexpr function
+/// result_holds_error::ram_address_out_of_range()"). Never called at run time.
+struct result_holds_error {
+  static void buffer_too_small() noexcept { __builtin_trap(); }
+  static void frame_too_short() noexcept { __builtin_trap(); }
+  static void frame_too_long() noexcept { __builtin_trap(); }
+  static void bad_frame_size() noexcept { __builtin_trap(); }
+  static void bad_checksum() noexcept { __builtin_trap(); }
+  static void unknown_command() noexcept { __builtin_trap(); }
+  static void bad_type_byte() noexcept { __builtin_trap(); }
+  static void reserved_bits_set() noexcept { __builtin_trap(); }
+  static void ics_out_of_range() noexcept { __builtin_trap(); }
+  static void ram_address_out_of_range() noexcept { __builtin_trap(); }
+  static void rom_address_out_of_range() noexcept { __builtin_trap(); }
+  static void ics_offset_out_of_range() noexcept { __builtin_trap(); }
+  static void transfer_size_out_of_range() noexcept { __builtin_trap(); }
+  static void literal_size_out_of_range() noexcept { __builtin_trap(); }
+  static void operand_size_out_of_range() noexcept { __builtin_trap(); }
+  static void ics_length_out_of_range() noexcept { __builtin_trap(); }
+  static void position_out_of_range() noexcept { __builtin_trap(); }
+  static void param_out_of_range() noexcept { __builtin_trap(); }
+  static void frames_out_of_range() noexcept { __builtin_trap(); }
+  static void shift_count_out_of_range() noexcept { __builtin_trap(); }
+  static void servo_id_out_of_range() noexcept { __builtin_trap(); }
+  static void motion_out_of_range() noexcept { __builtin_trap(); }
+  static void empty_servo_set() noexcept { __builtin_trap(); }
+  static void bad_condition() noexcept { __builtin_trap(); }
+  static void unknown_parameter_kind() noexcept { __builtin_trap(); }
+  static void destination_not_allowed() noexcept { __builtin_trap(); }
+  static void flags_only_not_allowed() noexcept { __builtin_trap(); }
+  static void bad_reply_length() noexcept { __builtin_trap(); }
+  static void echo_mismatch() noexcept { __builtin_trap(); }
+  static void bad_ack_code() noexcept { __builtin_trap(); }
+  static void unexpected_ack() noexcept { __builtin_trap(); }
+  static void nack() noexcept { __builtin_trap(); }
+  static void baud_change_not_allowed() noexcept { __builtin_trap(); }
+  static void unsupported_baud() noexcept { __builtin_trap(); }
+  static void index_out_of_range() noexcept { __builtin_trap(); }
+  static void motion_slot_empty() noexcept { __builtin_trap(); }
+  static void motion_slot_not_a_frame() noexcept { __builtin_trap(); }
+  static void servo_not_allocated() noexcept { __builtin_trap(); }
+  static void bad_allocation_table() noexcept { __builtin_trap(); }
+  static void ics_id_out_of_range() noexcept { __builtin_trap(); }
+  static void ics_value_out_of_range() noexcept { __builtin_trap(); }
+  static void ics_line_echo_mismatch() noexcept { __builtin_trap(); }
+  static void ics_bad_reply() noexcept { __builtin_trap(); }
+  static void ics_bad_eeprom() noexcept { __builtin_trap(); }
+};
+
+/// Fails a value() of a result holding @p e: in a constant expression at the function named
+/// after @p e; at run time a trap (one instruction: the names exist only for the compiler).
+constexpr void bad_result_access(errc e) noexcept {
+  if (!std::is_constant_evaluated()) return bad_result_access();
+  switch (e) {
+    case errc::buffer_too_small: return result_holds_error::buffer_too_small();
+    case errc::frame_too_short: return result_holds_error::frame_too_short();
+    case errc::frame_too_long: return result_holds_error::frame_too_long();
+    case errc::bad_frame_size: return result_holds_error::bad_frame_size();
+    case errc::bad_checksum: return result_holds_error::bad_checksum();
+    case errc::unknown_command: return result_holds_error::unknown_command();
+    case errc::bad_type_byte: return result_holds_error::bad_type_byte();
+    case errc::reserved_bits_set: return result_holds_error::reserved_bits_set();
+    case errc::ics_out_of_range: return result_holds_error::ics_out_of_range();
+    case errc::ram_address_out_of_range: return result_holds_error::ram_address_out_of_range();
+    case errc::rom_address_out_of_range: return result_holds_error::rom_address_out_of_range();
+    case errc::ics_offset_out_of_range: return result_holds_error::ics_offset_out_of_range();
+    case errc::transfer_size_out_of_range: return result_holds_error::transfer_size_out_of_range();
+    case errc::literal_size_out_of_range: return result_holds_error::literal_size_out_of_range();
+    case errc::operand_size_out_of_range: return result_holds_error::operand_size_out_of_range();
+    case errc::ics_length_out_of_range: return result_holds_error::ics_length_out_of_range();
+    case errc::position_out_of_range: return result_holds_error::position_out_of_range();
+    case errc::param_out_of_range: return result_holds_error::param_out_of_range();
+    case errc::frames_out_of_range: return result_holds_error::frames_out_of_range();
+    case errc::shift_count_out_of_range: return result_holds_error::shift_count_out_of_range();
+    case errc::servo_id_out_of_range: return result_holds_error::servo_id_out_of_range();
+    case errc::motion_out_of_range: return result_holds_error::motion_out_of_range();
+    case errc::empty_servo_set: return result_holds_error::empty_servo_set();
+    case errc::bad_condition: return result_holds_error::bad_condition();
+    case errc::unknown_parameter_kind: return result_holds_error::unknown_parameter_kind();
+    case errc::destination_not_allowed: return result_holds_error::destination_not_allowed();
+    case errc::flags_only_not_allowed: return result_holds_error::flags_only_not_allowed();
+    case errc::bad_reply_length: return result_holds_error::bad_reply_length();
+    case errc::echo_mismatch: return result_holds_error::echo_mismatch();
+    case errc::bad_ack_code: return result_holds_error::bad_ack_code();
+    case errc::unexpected_ack: return result_holds_error::unexpected_ack();
+    case errc::nack: return result_holds_error::nack();
+    case errc::baud_change_not_allowed: return result_holds_error::baud_change_not_allowed();
+    case errc::unsupported_baud: return result_holds_error::unsupported_baud();
+    case errc::index_out_of_range: return result_holds_error::index_out_of_range();
+    case errc::motion_slot_empty: return result_holds_error::motion_slot_empty();
+    case errc::motion_slot_not_a_frame: return result_holds_error::motion_slot_not_a_frame();
+    case errc::servo_not_allocated: return result_holds_error::servo_not_allocated();
+    case errc::bad_allocation_table: return result_holds_error::bad_allocation_table();
+    case errc::ics_id_out_of_range: return result_holds_error::ics_id_out_of_range();
+    case errc::ics_value_out_of_range: return result_holds_error::ics_value_out_of_range();
+    case errc::ics_line_echo_mismatch: return result_holds_error::ics_line_echo_mismatch();
+    case errc::ics_bad_reply: return result_holds_error::ics_bad_reply();
+    case errc::ics_bad_eeprom: return result_holds_error::ics_bad_eeprom();
+  }
+  bad_result_access();
+}
 }  // namespace detail
 
 /**
@@ -40,17 +143,17 @@ class [[nodiscard]] result {
   constexpr explicit operator bool() const noexcept { return has_value(); }
   /** The value; must hold one. */
   constexpr const T& value() const& noexcept {
-    if (!has_value()) detail::bad_result_access();
+    if (!has_value()) detail::bad_result_access(error_);
     return value_;
   }
   /** The value; must hold one. */
   constexpr T& value() & noexcept {
-    if (!has_value()) detail::bad_result_access();
+    if (!has_value()) detail::bad_result_access(error_);
     return value_;
   }
   /** The value, moved out; must hold one. */
   constexpr T&& value() && noexcept {
-    if (!has_value()) detail::bad_result_access();
+    if (!has_value()) detail::bad_result_access(error_);
     return std::move(value_);
   }
   /** The value, or @p fallback on error. */

@@ -38,6 +38,9 @@ struct frames_literal_out_of_range {
 struct servo_param_literal_out_of_range {
   static void fail();
 };
+/// False for every type: a static_assert that fails only when its template is used.
+template <class>
+inline constexpr bool always_false = false;
 struct servo_position_literal_out_of_range {
   static void fail();
 };
@@ -61,6 +64,12 @@ class bounded {
   /** From an integer constant; an out-of-range constant does not compile. */
   consteval bounded(long long v) : v_(static_cast<Rep>(v)) {  // NOLINT(google-explicit-constructor)
     if (v < Min || v > Max) Tag::fail();
+  }
+  /** A floating-point constant does not compile: the value is a whole number (no silent 2.5 → 2). */
+  template <std::floating_point F>
+  consteval bounded(F) {  // NOLINT(google-explicit-constructor)
+    static_assert(detail::always_false<F>,
+                  "rcb4: this value is a whole number: write an integer literal (10, not 10.0 or 2.5)");
   }
   /** From a run-time integer: the value, or Err when outside [Min, Max]. */
   template <std::integral I>
@@ -138,6 +147,12 @@ class servo_position {
   /** From an integer constant; an invalid constant does not compile. */
   consteval servo_position(long long v) : v_(static_cast<std::uint16_t>(v)) {  // NOLINT
     if (!valid(v)) detail::servo_position_literal_out_of_range::fail();
+  }
+  /** A floating-point constant does not compile: positions are whole units (no silent 7999.99 → 7999). */
+  template <std::floating_point F>
+  consteval servo_position(F) {  // NOLINT(google-explicit-constructor)
+    static_assert(detail::always_false<F>,
+                  "rcb4: a servo position is a whole number: write an integer literal (7500, not 7500.0)");
   }
   /** From a run-time integer; errc::position_out_of_range unless valid. */
   template <std::integral I>
