@@ -83,6 +83,15 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(p["left_knee"] == 10 and p["left_shoulder_roll"] == -5 and p["right_knee"] == 10,
               f"Right → left ({json.dumps(p)})")
         click(driver, "ed-undo")
+        for n in [j["name"] for j in hello["joints"] if j["name"].startswith("right_")]:  # a pose of left joints only
+            js(driver, "document.querySelector(`.pose-joint[data-joint=\"${arguments[0]}\"] input[type=checkbox]`).click()", n)
+        left_only = pose(driver)
+        click(driver, "ed-r2l")
+        check(pose(driver) == left_only and "no right joint" in message(driver),
+              f"Right → left on a pose with no right joint changes nothing and says so ({message(driver)!r})")
+        for _ in range(len(p0) - len(left_only)):  # one undo per joint unticked
+            click(driver, "ed-undo")
+        check(pose(driver) == p0, "and Undo brings the whole pose back")
 
         # A second pose: Home, then one joint as in the pose before.
         click(driver, "ed-add")
@@ -171,6 +180,12 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         add("loop")
         field("f-goto", "again")
         click(driver, "ed-step-apply")
+        add("if_ram")  # a RAM test: an AD sensor branch, its address typed as in the docs
+        field("f-address", "0x0050")
+        field("f-compare", "at_least")
+        field("f-value", "600")
+        field("f-goto", "again")
+        click(driver, "ed-step-apply")
         add("speed")
         js(driver, """const t = document.querySelector('#ed-detail .param-target'); t.value = 'legs';
                       document.querySelector('#ed-detail .param-value').value = 60;""")
@@ -178,7 +193,8 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         steps = js(driver, "return window.rcb4Studio.editor.doc.steps")
         shape = [s if not (isinstance(s, dict) and "pose" in s) else "pose" for s in steps]
         check(shape == [{"label": "again"}, {"set_counter": 4}, "pose", {"if_buttons": "s1+circle", "goto": "again"},
-                        {"loop": "again"}, {"speed": {"legs": 60}}, "end"],
+                        {"loop": "again"}, {"if_ram": 80, "size": 2, "at_least": 600, "goto": "again"},
+                        {"speed": {"legs": 60}}, "end"],
               f"the steps as the forms made them ({shape})")
         field("ed-slot", "11")
         click(driver, "ed-push")

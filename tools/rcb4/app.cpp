@@ -407,8 +407,8 @@ failure explain(const std::error_code& ec, std::string_view what) {
   }
   if (t::is_link_lost(ec))
     return {exit_io, std::string(what),
-            "the device went away (unplugged?); over TCP at the first exchange: the server has another client "
-            "(rcb4 serve --tcp and ser2net serve one at a time)"};
+            "the device went away (unplugged?), or the rcb4 ui this went through stopped; over TCP at the first "
+            "exchange: the server has another client (rcb4 serve --tcp and ser2net serve one at a time)"};
   return {exit_io, std::string(what)};
 }
 

@@ -86,6 +86,10 @@ const on = {
     ui.motions = m.motions;
     renderPoses(m.poses, m.poses_dir);
     renderMotions();
+    // The slot table too when the slots changed (another program wrote or erased one).
+    const slots = JSON.stringify(m.motions.map((x) => [x.slot, x.frames]));
+    if (ui.slotsSeen !== undefined && slots !== ui.slotsSeen) ui.studio?.tables.list();
+    ui.slotsSeen = slots;
   },
   state(m) {
     ui.lastState = m;

@@ -16,7 +16,7 @@ const KINDS = {
   loop: () => ({ loop: 'again' }),
   if_buttons: () => ({ if_buttons: 'up', goto: 'again' }),
   unless_buttons: () => ({ unless_buttons: 'up', goto: 'again' }),
-  if_ram: () => ({ if_ram: '0x0050', size: 2, at_least: 512, goto: 'again' }),
+  if_ram: () => ({ if_ram: 0x0050, size: 2, at_least: 512, goto: 'again' }),
   goto: () => ({ goto: 'again' }),
   call: () => ({ call: 2 }),
   speed: () => ({ speed: { all: 127 } }),
@@ -396,6 +396,13 @@ export function createEditor(root, ctx) {
       : `plays ${(played / 1000).toFixed(2)} s as the board would (loops counted, no button held)`);
     renderDetail();
     ctx.view?.setGhost(poseAt(ed.sel));
+    // Live on the robot: the robot shows the selected pose, whatever changed it (an edit, a pose
+    // tool, undo or redo, another step selected), at the server's speed limit.
+    const cur = ed.doc.steps[ed.sel];
+    if (ed.live && kindOf(cur) === 'pose' && ctx.controlling()) {
+      const key = JSON.stringify(cur.pose);
+      if (key !== ed.liveSent) { ed.liveSent = key; sendLive(cur.pose); }
+    }
     ctx.controls();
   }
 
@@ -426,7 +433,15 @@ export function createEditor(root, ctx) {
       apply.addEventListener('click', () => {
         const r = form.read();
         if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}: nothing changed`, 'error');
-        change(() => { ed.doc.steps[ed.sel] = r.step; });
+        change(() => {
+          ed.doc.steps[ed.sel] = r.step;
+          if (r.renamed) {  // a renamed label: the jumps to it follow
+            const [from, to] = r.renamed;
+            for (const x of ed.doc.steps)
+              for (const key of ['goto', 'loop', 'count_down'])
+                if (x && typeof x === 'object' && x[key] === from && !(key === 'goto' && 'label' in x)) x[key] = to;
+          }
+        });
       });
       detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), form.el, el('div', { class: 'row' }, apply));
       return;
@@ -445,7 +460,7 @@ export function createEditor(root, ctx) {
     });
     const live = el('input', { id: 'ed-live', type: 'checkbox', class: 'needs-control' });
     live.checked = !!ed.live;
-    live.addEventListener('change', () => { ed.live = live.checked; if (ed.live) sendLive(s.pose); });
+    live.addEventListener('change', () => { ed.live = live.checked; ed.liveSent = null; if (ed.live) render(); });
     const rows = h.joints.map((j) => {
       const on = j.name in s.pose;
       const v = on ? s.pose[j.name] : poseAt(ed.sel - 1)[j.name] ?? 0;

@@ -64,8 +64,12 @@ export function problems(doc, kindOf) {
       else if (!sets(0, top)) out[i].warn.push('no counter is set before this loop: it counts from whatever the RAM holds');
     }
   });
+  const seen = new Set();
   steps.forEach((s, i) => {
-    if (kindOf(s) === 'label' && !targeted.has(s.label)) out[i].warn.push(`nothing jumps to ${s.label}`);
+    if (kindOf(s) !== 'label') return;
+    if (seen.has(s.label)) out[i].bad.push(`another label is called ${s.label}: the board would not know which`);
+    seen.add(s.label);
+    if (!targeted.has(s.label)) out[i].warn.push(`nothing jumps to ${s.label}`);
   });
   const last = steps.length - 1;
   if (last >= 0 && !['end', 'goto'].includes(kindOf(steps[last])))
@@ -133,6 +137,10 @@ export function createFlowchart(box, api) {
     drag.moved ||= Math.abs(p.x - drag.start.x) + Math.abs(p.y - drag.start.y) > 3;
     drag.x = p.x;
     drag.y = p.y;
+    // Near the box's top or bottom edge the box scrolls, so a jump reaches a block out of view.
+    const b = box.getBoundingClientRect();
+    if (e.clientY > b.bottom - 24) box.scrollTop += 16;
+    else if (e.clientY < b.top + 24) box.scrollTop -= 16;
     render();
   });
   const end = (e) => {

@@ -18,13 +18,19 @@ export function mirrorPose(hello, pose, which) {
   for (const j of hello.joints) {
     const m = j.mirror;
     if (!m || (which !== 'both' && m.side !== which)) continue;
-    if (!(j.name in pose)) { delete out[m.joint]; continue; }
+    if (!(j.name in pose)) {  // mirrored: its image leaves the pose too; copied: nothing to copy
+      if (which === 'both') delete out[m.joint];
+      continue;
+    }
     const v = pose[j.name] * m.sign + 0;  // + 0: never -0
     const lim = limits.get(m.joint);
     if (lim && (v < lim.lower || v > lim.upper))
       return { why: `${m.joint} would be ${v}°, beyond its limits ${lim.lower}..${lim.upper}: nothing changed` };
     out[m.joint] = v;
   }
+  if (which !== 'both' && !hello.joints.some((j) => j.mirror?.side === which && j.name in pose))
+    return { why: `this pose has no ${which} joint to copy: nothing changed` };
+  if (!Object.keys(out).length) return { why: 'the pose would have no joint: nothing changed' };
   return { pose: out };
 }
 

@@ -82,9 +82,17 @@ function remotePad(initial) {
 const KIND_FORMS = {
   end: () => ({ el: el('div', { class: 'small muted', text: 'the motion ends here (RETURN)' }), read: () => ({ step: 'end' }) }),
 
-  label(s) {
+  label(s, ctx) {
     const name = el('input', { id: 'f-label', value: s.label, maxlength: 32, 'aria-label': 'label name' });
-    return { el: field('label', name), read: () => (name.value.trim() ? { step: { label: name.value.trim() } } : fail('a label needs a name')) };
+    return {
+      el: field('label (the jumps to it follow a new name)', name),
+      read: () => {
+        const n = name.value.trim();
+        if (!n) return fail('a label needs a name');
+        if (n !== s.label && ctx.labels.includes(n)) return fail(`another label is called ${n} already`);
+        return { step: { label: n }, renamed: n !== s.label ? [s.label, n] : null };
+      },
+    };
   },
 
   set_counter(s) {
@@ -97,7 +105,7 @@ const KIND_FORMS = {
         if (r.value === null) return fail(r.why || 'type the count, 0 to 255');
         const a = addressIn(c, 'the counter');
         if (a.why) return fail(a.why);
-        return { step: a.value === null ? { set_counter: r.value } : { set_counter: r.value, counter: hex4(a.value) } };
+        return { step: a.value === null ? { set_counter: r.value } : { set_counter: r.value, counter: a.value } };
       },
     };
   },
@@ -126,7 +134,7 @@ const KIND_FORMS = {
         if (r.value === null) return fail(r.why || 'type the value to compare with');
         const t = to.read();
         if (t.why) return t;
-        return { step: { if_ram: hex4(a.value), size: n, [how.value]: r.value, goto: t.value } };
+        return { step: { if_ram: a.value, size: n, [how.value]: r.value, goto: t.value } };
       },
     };
   },
@@ -179,7 +187,7 @@ function countDown(s, ctx, kind) {
       const a = addressIn(c, 'the counter');
       if (a.why) return fail(a.why);
       const step = { [kind]: t.value };
-      if (a.value !== null) step.counter = hex4(a.value);
+      if (a.value !== null) step.counter = a.value;
       if (kind === 'count_down' && when.value === 'zero') step.when = 'zero';
       return { step };
     },
