@@ -5,7 +5,6 @@
 #include "studio_ops.hpp"
 
 #include <rcb4/motion/disassemble.hpp>
-#include <rcb4/robot/mirror.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/moves.hpp>
 #include <rcb4/robot/services/slot_names.hpp>
@@ -28,8 +27,6 @@ json degrees_json(std::optional<double> d) {
   const double r = std::round(*d * 100) / 100;
   return r == 0 ? 0.0 : r;
 }
-
-std::string text_of(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
 /** An error for a page: the words of the failure, and its hint. */
 std::string words_of(const std::error_code ec, std::string_view what) {
@@ -602,48 +599,5 @@ class loop {
 }  // namespace
 
 void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) { loop(s, m, h, o).run(); }
-
-std::string hello_text(const robot::model& m, const session& s, const loop_options& o, const settings& limits) {
-  json j;
-  j["type"] = "hello";
-  j["robot"] = m.name();
-  // Each joint's mirror image (robot/mirror.hpp), from the body: the page mirrors a pose and
-  // copies a limb with it; null where the body gives none (nothing is guessed from names).
-  std::vector<std::string> names;
-  for (const auto& jt : m.joints()) names.push_back(jt.name);
-  const auto images =
-      m.body() ? robot::mirror_images(*m.body(), names) : std::vector<std::optional<robot::mirror_image>>(names.size());
-  json joints = json::array();
-  for (std::size_t n = 0; n < names.size(); ++n) {
-    const auto& jt = m.joints()[n];
-    json mirror = nullptr;
-    if (const auto& i = images[n])
-      mirror = {{"joint", names[i->joint]},
-                {"sign", i->sign},
-                {"side", i->left    ? "left"
-                         : i->right ? "right"
-                                    : "middle"}};
-    joints.push_back({{"name", jt.name},
-                      {"ics", jt.ics.value()},
-                      {"lower", jt.lower},
-                      {"upper", jt.upper},
-                      {"mirror", std::move(mirror)}});
-  }
-  j["joints"] = std::move(joints);
-  json groups = json::array();
-  for (const auto& g : m.groups()) groups.push_back({{"name", g.name}, {"joints", g.joints}});
-  j["groups"] = std::move(groups);
-  json link;
-  link["device"] = s.where();
-  link["baud"] = s.rate_known() ? json(s.baud()) : json(nullptr);
-  link["virtual"] = s.is_virtual();
-  j["link"] = std::move(link);
-  j["max_speed"] = limits.max_speed;
-  j["max_move_ms"] = max_move_ms;
-  j["period_ms"] = o.period.count();
-  j["version"] = RCB4_VERSION;
-  j["body"] = body_json(m);
-  return text_of(j);
-}
 
 }  // namespace cli::ui

@@ -25,6 +25,9 @@ namespace cli::ui {
 /** The robot's body (the profile's kinematics) for the page's 3D view, or null when the profile has none. */
 json body_json(const rcb4::robot::model& m);
 
+/** @p j as the text a page gets (bytes that are no UTF-8 replaced, never an exception). */
+inline std::string text_of(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
 /** A studio op that did not do what it was asked: the words for the page (nothing was changed unless they say so). */
 struct studio_refusal : std::runtime_error {
   using std::runtime_error::runtime_error;
