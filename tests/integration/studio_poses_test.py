@@ -216,6 +216,9 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(len(blocks) == 5 and bad == [1, 3],
               f"a jump to no label is marked as it is built, not at push ({bad}: {[b['title'] for b in blocks if ' bad' in b['cls']]})")
 
+        summary = js(driver, "return document.getElementById('ed-summary').textContent")
+        check("does not play: no label called again" in summary, f"and the summary says it does not play ({summary!r})")
+
         def drag_wire(src, dst):
             js(driver, """const svg = document.getElementById('ed-flow');
                 const exit = svg.querySelector(`.flow-exit[data-step="${arguments[0]}"]`);

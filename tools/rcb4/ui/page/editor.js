@@ -268,7 +268,8 @@ export function createEditor(root, ctx) {
     clampSel();
     keep();
     name.value = ed.doc.name || '';
-    const segs = (() => { try { return segments(ed.doc.steps, ctx.measured()); } catch { return []; } })();
+    let unplayable = null;  // why the board could not play it (a jump to no label): said in the summary
+    const segs = (() => { try { return segments(ed.doc.steps, ctx.measured()); } catch (e) { unplayable = e.message; return []; } })();
     steps.replaceChildren(...ed.doc.steps.map((s, i) => {
       const k = kindOf(s);
       const bad = k === 'pose' && Object.entries(s.pose).some(([n, v]) => limits.has(n) && (v < limits.get(n).lower || v > limits.get(n).upper));
@@ -292,8 +293,9 @@ export function createEditor(root, ctx) {
       return b;
     }));
     const played = segs.reduce((a, g) => a + g.ms, 0);
-    summary.textContent = `${ed.doc.steps.length} steps, ${poses.length} poses; ` + (segs.endless
-      ? 'plays until stopped: it goes round for ever (no button held)'
+    summary.textContent = `${ed.doc.steps.length} steps, ${poses.length} poses; ` + (unplayable
+      ? `does not play: ${unplayable}`
+      : segs.endless ? 'plays until stopped: it goes round for ever (no button held)'
       : `plays ${(played / 1000).toFixed(2)} s as the board would (loops counted, no button held)`);
     renderDetail();
     ctx.view?.setGhost(poseAt(ed.sel));
@@ -333,7 +335,7 @@ export function createEditor(root, ctx) {
       const apply = el('button', { type: 'button', id: 'ed-step-apply' }, 'Apply');
       apply.addEventListener('click', () => {
         const r = form.read();
-        if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}: nothing changed`, 'error');
+        if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}` + (r.why.endsWith('nothing changed') ? '' : ': nothing changed'), 'error');
         change(() => {
           ed.doc.steps[ed.sel] = r.step;
           if (r.renamed) {  // a renamed label: the jumps to it follow
@@ -521,7 +523,7 @@ export function createEditor(root, ctx) {
     let skip = 0;
     if (fromSel) {
       const k = segs.findIndex((g) => g.step >= ed.sel);
-      if (k < 0) return ctx.say(`preview: the motion never reaches step ${ed.sel + 1} (no button held, RAM 0)`, 'error');
+      if (k < 0) return ctx.say(`preview: no pose is played from step ${ed.sel + 1} on (no button held, RAM 0)`, 'error');
       skip = segs.slice(0, k).reduce((a, g) => a + g.ms, 0);
     }
     const t0 = performance.now() - skip;
