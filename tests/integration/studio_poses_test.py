@@ -44,6 +44,10 @@ def message(driver):
 
 with serve() as dev, tempfile.TemporaryDirectory() as poses:
     os.environ["RCB4_SLOT_NAMES"] = os.path.join(poses, "slot-names.yaml")  # not the user's own
+    with open(os.path.join(poses, "crouch.yaml"), "w") as f:  # saved poses, as `rcb4 pose capture` writes them
+        f.write("robot: KHR-3HV\ntime_ms: 800\njoints:\n  left_knee: 60\n  right_knee: -60\n")
+    with open(os.path.join(poses, "broken.yaml"), "w") as f:
+        f.write("robot: KHR-3HV\njoints:\n  left_knee: 400\n")
     ui = Ui("--device", dev, "ui", "--listen", "127.0.0.1:0", "--poses", poses)
     driver = browser()
     try:
@@ -297,6 +301,18 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
             if len(sys.argv) > 2:
                 driver.save_screenshot(os.path.join(sys.argv[2], f"rcb4-studio-{w}x{h}.png"))
         driver.set_window_size(1400, 1080)
+
+        # A saved pose inserted into the motion from the Poses panel; one beyond a limit is refused.
+        js(driver, "window.rcb4Studio.editor.sel = 0")
+        n_steps = len(js(driver, "return window.rcb4Studio.editor.doc.steps"))
+        js(driver, "document.querySelector('#poses li[data-pose=crouch] button.insert').click()")
+        got = wait_until(lambda: js(driver, "const s = window.rcb4Studio.editor.doc.steps; return s.length > arguments[0] && s[1]", n_steps))
+        check(got == {"pose": {"left_knee": 60, "right_knee": -60}, "time_ms": 800},
+              f"Insert: the saved pose crouch becomes step 2 with its time ({got}, {message(driver)!r})")
+        js(driver, "document.querySelector('#poses li[data-pose=broken] button.insert').click()")
+        check(wait_until(lambda: "beyond its limits" in message(driver), timeout=5)
+              and len(js(driver, "return window.rcb4Studio.editor.doc.steps")) == n_steps + 1,
+              f"a saved pose beyond a limit is not inserted, and says why ({message(driver)!r})")
 
         # Nothing of it moved the robot: live was off.
         after = {n: j["degrees"] for n, j in joints_on(dev).items()}

@@ -444,13 +444,11 @@ class loop {
   }
 
   std::filesystem::path pose_path(const std::string& name, bool for_reading) const {
-    const auto yaml = o_.poses / (name + ".yaml");
-    if (!for_reading) return yaml;
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(yaml, ec)) return yaml;
-    const auto json_file = o_.poses / (name + ".json");
-    if (std::filesystem::is_regular_file(json_file, ec)) return json_file;
-    throw refusal{fmt::format("no pose called '{}' in {} (NAME.yaml or NAME.json)", name, o_.poses.string())};
+    try {
+      return ui::pose_path(o_.poses, name, for_reading);
+    } catch (const studio_refusal& e) {
+      throw refusal{e.what()};
+    }
   }
 
   json act(const capture_action& a) {

@@ -22,6 +22,7 @@
 //   {"op":"motion_pull","slot":10}                     a slot as a motion file: {"motion": {...}, "yaml": "..."}
 //   {"op":"motion_check","text":"robot: ..."}          a motion file (YAML or JSON text) parsed and compiled
 //   {"op":"buttons"}, {"op":"trims"}                   the button table (RAM, ROM), every joint's trim
+//   {"op":"pose_read","name":"wave"}                   a saved pose's joints (for a motion's step)
 // Only the controlling page may change something:
 //   {"op":"motion_push","slot":10,"text":"...","dry_run":false}   write a motion (backup first)
 //   {"op":"motion_erase","slot":10}, {"op":"motion_resume"}
@@ -113,7 +114,8 @@ struct studio_request {
 
 /** True for a studio op that only reads (any page may ask it); the others need control. */
 inline bool studio_reads(std::string_view op) noexcept {
-  return op == "motion_list" || op == "motion_pull" || op == "motion_check" || op == "buttons" || op == "trims";
+  return op == "motion_list" || op == "motion_pull" || op == "motion_check" || op == "buttons" || op == "trims" ||
+         op == "pose_read";
 }
 
 /** What a page asks. */

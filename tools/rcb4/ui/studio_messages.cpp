@@ -32,6 +32,10 @@ std::optional<request> studio_body_of(const json& o, const std::string& op) {
   r.op = op;
   if (op == "motion_list" || op == "buttons" || op == "trims") {
     only_keys(o, op, {"op", "id"});
+  } else if (op == "pose_read") {
+    only_keys(o, op, {"op", "id", "name"});
+    if (!valid_pose_name(name_of(required(o, op, "name"), op, "name")))
+      throw refused{"pose_read: a pose name uses A-Z, a-z, 0-9, _ and -"};
   } else if (op == "motion_pull") {
     only_keys(o, op, {"op", "id", "slot"});
     slot_of(o, op);

@@ -208,6 +208,7 @@ json studio_ops::act(const studio_action& a, client_id from) {
       return json::object();
     }
     if (op == "trims") return trims();
+    if (op == "pose_read") return pose_read(args.at("name").get<std::string>());
     if (op == "trim_set") {
       std::vector<std::pair<std::string, double>> items;
       for (const auto& [k, v] : args.at("joints").items()) items.emplace_back(k, v.get<double>());
@@ -392,6 +393,38 @@ json studio_ops::trims() {
                    {"rom_degrees", rom ? json(std::round(*rom * 100) / 100) : json(nullptr)}});
   }
   return json{{"trims", out}};
+}
+
+std::filesystem::path pose_path(const std::filesystem::path& folder, const std::string& name, bool for_reading) {
+  const auto yaml = folder / (name + ".yaml");
+  if (!for_reading) return yaml;
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(yaml, ec)) return yaml;
+  const auto json_file = folder / (name + ".json");
+  if (std::filesystem::is_regular_file(json_file, ec)) return json_file;
+  throw studio_refusal(fmt::format("no pose called '{}' in {} (NAME.yaml or NAME.json)", name, folder.string()));
+}
+
+json studio_ops::pose_read(const std::string& name) {
+  // Checked against this robot as `pose play` checks it: names, limits (nothing reaches the board).
+  robot::pose p;
+  try {
+    p = robot::load_pose(pose_path(o_.poses, name, true), m_);
+  } catch (const studio_refusal&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw studio_refusal(std::string(plain_message(e.what())));
+  }
+  json joints = json::object();
+  for (const auto& [joint, degrees] : p.joints) {
+    const auto* j = m_.find(joint);
+    if (j && (degrees < j->lower || degrees > j->upper))
+      throw studio_refusal(fmt::format("{}: {} is {}°, beyond its limits {}..{}: not inserted", name, joint,
+                                       robot::number_text(degrees), robot::number_text(j->lower),
+                                       robot::number_text(j->upper)));
+    joints[joint] = degrees;
+  }
+  return {{"name", name}, {"joints", std::move(joints)}, {"time_ms", p.time ? json(p.time->count()) : json(nullptr)}};
 }
 
 json studio_ops::hand(const std::string& joint, double degrees) {

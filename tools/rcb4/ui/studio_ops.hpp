@@ -25,6 +25,9 @@ namespace cli::ui {
 /** The robot's body (the profile's kinematics) for the page's 3D view, or null when the profile has none. */
 json body_json(const rcb4::robot::model& m);
 
+/** Where saved pose @p name is in @p folder: NAME.yaml, or an existing NAME.json when @p for_reading. */
+std::filesystem::path pose_path(const std::filesystem::path& folder, const std::string& name, bool for_reading);
+
 /** @p j as the text a page gets (bytes that are no UTF-8 replaced, never an exception). */
 inline std::string text_of(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
 
@@ -61,6 +64,7 @@ class studio_ops {
   json play(const std::string& text, client_id from);
   json buttons();
   json trims();
+  json pose_read(const std::string& name);
   json hand(const std::string& joint, double degrees);
   json rom_backup();
   /** Where a backup of @p what ("motion-10") goes: POSES/backups/WHAT-DATE.bin (the folder made). */

@@ -294,10 +294,22 @@ function renderPoses(poses, dir) {
   const list = $('#poses');
   list.replaceChildren(...poses.map((p) => el('li', { 'data-pose': p },
     el('span', { text: p }),
-    el('button', { type: 'button', class: 'play needs-control', onclick: () => playPose(p) }, 'Play'))));
+    el('button', { type: 'button', class: 'play needs-control', onclick: () => playPose(p) }, 'Play'),
+    el('button', { type: 'button', class: 'insert', title: 'insert into the motion in the editor, after the selected step',
+      onclick: () => insertPose(p) }, 'Insert'))));
   if (!poses.length) list.append(el('li', { class: 'muted', text: 'no pose saved yet' }));
   $('#poses-dir').textContent = dir ? `saved in ${dir}` : '';
   setRole(ui.role, ui.controlled);
+}
+
+/** A saved pose into the motion being edited, as a new pose step (read and checked by the server). */
+async function insertPose(name) {
+  try {
+    const r = await request({ op: 'pose_read', name });
+    ui.studio?.editor.insertPose(r.joints, r.time_ms, name);
+  } catch (e) {
+    say(`${name}: ${e.message}`, 'error');
+  }
 }
 
 function playPose(name) {

@@ -588,6 +588,14 @@ export function createEditor(root, ctx) {
     /** The selected step's index; setting it selects that step (tests). */
     get sel() { return ed.sel; },
     set sel(i) { ed.sel = i; render(); },
+    /** Inserts a saved pose (@p joints: name → degrees) as a pose step after the selected one. */
+    insertPose(joints, timeMs, poseName) {
+      const period = ed.doc.period_ms || 10;
+      const ok = Number.isInteger(timeMs) && timeMs >= period && timeMs <= 255 * period;
+      insert({ pose: { ...joints }, time_ms: ok ? timeMs : 500 });
+      const own = ok || timeMs === null || timeMs === undefined ? '' : ` over 500 ms (its own ${timeMs} ms is no pose time here)`;
+      ctx.say(`pose ${poseName} inserted as step ${ed.sel + 1}${own}`);
+    },
     /** Where the last preview started, ms into the motion (tests). */
     get previewFrom() { return ed.previewFrom ?? null; },
     /** The undo and redo depths, and whether the motion has unsaved changes (tests). */
