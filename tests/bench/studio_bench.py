@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # The studio's speed, printed (not asserted): frames the 3D view draws per second while the board
-# is read at the page's period, and how long a slider change takes to reach the board (the
+# is read at the page's period and while a motion plays, Chromium's CPU while nothing moves, and how long a slider change takes to reach the board (the
 # page's performance clock, from the slider's input event to the first state in which the board's
 # output for that joint has started toward the new angle), on `rcb4 serve --pty --pace` (the line at 1.25 Mbaud), in Debian's
 # headless Chromium drawing WebGL with SwiftShader (a CPU: a GPU draws faster).
@@ -61,6 +61,37 @@ try:
                 acked.append(ms[1])
         time.sleep(0.6)
     period = d.execute_script("return window.rcb4Studio.hello.period_ms")
+
+    # The page's CPU while the robot stands still: Chromium's processes (browser, renderer, GPU
+    # process drawing with SwiftShader), CPU seconds per wall second over 5 s, from /proc.
+    def chromium_cpu():
+        ticks = 0
+        for pid in os.listdir("/proc"):
+            if not pid.isdigit():
+                continue
+            try:
+                with open(f"/proc/{pid}/cmdline", "rb") as f:
+                    if b"chromium" not in f.read().split(b"\0")[0]:
+                        continue
+                with open(f"/proc/{pid}/stat") as f:
+                    fields = f.read().rsplit(")", 1)[1].split()
+                ticks += int(fields[11]) + int(fields[12])  # utime + stime
+            except OSError:
+                continue
+        return ticks / os.sysconf("SC_CLK_TCK")
+
+    time.sleep(2)  # the slider moves above have settled
+    c0, w0 = chromium_cpu(), time.time()
+    time.sleep(5)
+    idle_cpu = (chromium_cpu() - c0) / (time.time() - w0)
+    # The frame rate while a motion plays (slot 2 of the virtual board, 0.7 s) and the page follows it.
+    f0, t0 = d.execute_script("return [window.rcb4Studio.view.stats.frames, performance.now()]")
+    d.execute_script("window.rcb4Studio.request({op: 'motion_play', slot: 2})")
+    time.sleep(0.7)
+    f1, t1 = d.execute_script("return [window.rcb4Studio.view.stats.frames, performance.now()]")
+    print(f"Chromium's CPU while the robot stands still: {idle_cpu * 100:.0f} % of a core "
+          f"(the 3D view draws on change only)")
+    print(f"3D view while motion 2 plays: {(f1 - f0) / ((t1 - t0) / 1000):.1f} frames/s")
     print(f"3D view: {(f1 - f0) / secs:.1f} frames/s while the board is read {(s1 - s0) / secs:.1f} times/s "
           f"(the page's period {period} ms)")
     if acked:
