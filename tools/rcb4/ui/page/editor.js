@@ -220,8 +220,7 @@ export function createEditor(root, ctx) {
     if (kindOf(s) !== 'pose') return;
     const r = fn(s.pose);
     if (!r.pose) return ctx.say(r.why, 'error');
-    change(() => { s.pose = r.pose; });
-    if (ed.live) sendLive(r.pose);
+    change(() => { s.pose = r.pose; });  // live on the robot: render() sends the pose
   }
   function home() {  // every joint of the pose at 0°, the robot's home with its trims
     reshape((pose) => {
@@ -383,8 +382,7 @@ export function createEditor(root, ctx) {
         // the joint joins the pose at the angle its box shows, checked as a typed one is
         const r = numberIn(num, { min: j.lower, max: j.upper, what: j.name, unit: '°' });
         if (r.value === null) { tick.checked = false; return ctx.say(r.why || `${j.name}: type its angle first`, 'error'); }
-        change(() => { s.pose[j.name] = r.value; });
-        if (ed.live) sendLive({ [j.name]: r.value });
+        change(() => { s.pose[j.name] = r.value; });  // live: render() sends the pose
       });
       const set = (x, commit) => {
         if (!(x >= j.lower && x <= j.upper)) {  // refused: said, shown red a moment, the kept value back
@@ -394,8 +392,13 @@ export function createEditor(root, ctx) {
           return;
         }
         row.classList.remove('beyond');
-        if (commit) change(() => { s.pose[j.name] = x; }); else { s.pose[j.name] = x; ctx.view?.setGhost(poseAt(ed.sel)); }
-        if (ed.live) sendLive({ [j.name]: x });
+        if (commit) {
+          change(() => { s.pose[j.name] = x; });  // live: render() sends the pose
+        } else {  // a drag: the joint goes live as it moves (render() comes at the drag's end)
+          s.pose[j.name] = x;
+          ctx.view?.setGhost(poseAt(ed.sel));
+          if (ed.live) sendLive({ [j.name]: x });
+        }
       };
       // A drag is one undo step: the motion as it was before the drag's first movement.
       let beforeDrag = null;
