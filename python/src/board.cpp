@@ -44,7 +44,8 @@ void raise(const std::error_code& ec, const std::string& what) {
     throw board_error(
         fault::timeout,
         text + " (is the board powered, the cable in, the baud right? a slow link needs a longer timeout)");
-  if (ec == t::transport_errc::truncated || ec == t::transport_errc::echo) throw board_error(fault::bad_reply, text);
+  if (ec == t::transport_errc::truncated || ec == t::transport_errc::echo || ec == t::transport_errc::line_error)
+    throw board_error(fault::bad_reply, text);
   if (ec == std::errc::inappropriate_io_control_operation)
     throw board_error(fault::device, what + ": not a serial port", ENOTTY);
   // An OS error keeps its number (DeviceError.errno); others (a busy port, a lost link) have none.
@@ -166,13 +167,14 @@ void board::fail(const std::error_code& ec, const std::string& what) {
   const bool line_fault = ec == t::transport_errc::timeout || ec == t::transport_errc::no_board ||
                           ec == t::transport_errc::truncated || ec == t::transport_errc::closed ||
                           ec == t::transport_errc::settings_not_kept || ec == t::transport_errc::echo ||
-                          ec.category() == rcb4::codec_category();
+                          ec == t::transport_errc::line_error || ec.category() == rcb4::codec_category();
   if (line_fault && line_fd_ >= 0) {
     t::detail::kernel_termios2 now{};
     if (::ioctl(line_fd_, t::detail::tcgets2, &now) == 0) {
       const bool rate = t::detail::rate_close(now.c_ospeed, line_baud_);
+      // (PARMRK too: without it an intact 0xFF arrives single, and the marked line's decoding fails)
       const bool raw = (now.c_lflag & (ICANON | ECHO | ISIG)) == 0 && (now.c_cflag & CSIZE) == CS8 &&
-                       (now.c_iflag & (IXON | ICRNL)) == 0;
+                       (now.c_iflag & (IXON | ICRNL)) == 0 && t::detail::iflag_marks(now.c_iflag);
       if (!rate || !raw) {
         std::uint32_t got = 0;
         bool parity = false;

@@ -380,6 +380,10 @@ failure explain(const std::error_code& ec, std::string_view what) {
     return {exit_board, std::string(what),
             "a board answered but its reply stopped short: a noisy or failing line, a wrong baud, or a board "
             "busy with something else"};
+  if (ec == t::transport_errc::line_error)
+    return {exit_board, std::string(what),
+            "a byte of the board's reply failed its parity check, every try: a noisy or too long cable, a loose "
+            "connector, a wrong baud, or a second device on the line; damaged bytes are never used"};
   if (ec == t::transport_errc::port_busy)
     return {exit_io, std::string(what),
             "another program has the port open (`fuser -v` on the device shows which); a port rcb4 ui holds is "

@@ -65,15 +65,24 @@ ics::servo_id ics_servo::read_id(bool for_id_write) {
   const ics::read_id c;
   const auto req = c.request();
   std::vector<std::uint8_t> rx;
+  bool damaged = false;
   for (int attempt = 0; attempt < std::max(1, o_.tries); ++attempt) {
     rx = l_.transact(req.view(), req.size + 1, wait_for(req.size + 1, l_.baud(), o_.timeout));
-    if (rx.size() > req.size) break;
+    damaged = l_.last_damaged();
+    if (rx.size() > req.size && !damaged) break;
+    if (damaged) (void)l_.linger(o_.timeout);  // the rest of the damaged answer passes first
   }
+  const auto where = fmt::format("the ID read (FF 00 00 00) at {} baud", l_.baud());
+  if (damaged)
+    throw refused(refusal_kind::board,
+                  fmt::format("the answer to {} had a byte that failed its parity check, at the last of {} tries "
+                              "(received {} before it): a noisy line, or a second device answering at once",
+                              where, std::max(1, o_.tries), rx.empty() ? std::string("nothing") : hex(rx)),
+                  "one servo alone on the adapter, its own supply; a damaged reply is never used");
   // A second device answers late or garbled: within the first one's turnaround (an adapter's latency timer).
   const auto extra = l_.linger(std::clamp(o_.timeout / 4, std::chrono::milliseconds(5), std::chrono::milliseconds(50)));
   rx.insert(rx.end(), extra.begin(), extra.end());
   const auto p = ics::parse_exchange(c, rx);
-  const auto where = fmt::format("the ID read (FF 00 00 00) at {} baud", l_.baud());
   if (p.status == parse_status::need_more && rx.size() <= req.size)
     throw refused(refusal_kind::timeout, fmt::format("no answer to {}", where), hint_wiring);
   const bool one_byte = rx.size() == req.size + 1 && p.error != errc::ics_line_echo_mismatch;

@@ -98,8 +98,13 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
     const auto rx = l_.transact(req.view(), expect, wait_for(expect, l_.baud(), wait));
     echoed_ = echoed_ || !rx.empty();
     const auto p = ics::parse_exchange(c, rx);
-    if (p.ok() && rx.size() == p.consumed) return p.value;
-    if (p.ok()) {
+    if (l_.last_damaged()) {  // (checked first: the bytes before the damaged one may parse as a shorter reply)
+      last = fmt::format("byte {} of echo and reply failed its parity check (received {} before it)", rx.size() + 1,
+                         rx.empty() ? std::string("nothing") : hex(rx));
+      answered = true;
+    } else if (p.ok() && rx.size() == p.consumed) {
+      return p.value;
+    } else if (p.ok()) {
       last = fmt::format("{} bytes more than the reply came back ({}): another device answered too",
                          rx.size() - p.consumed, hex(std::span(rx).subspan(p.consumed)));
       answered = true;

@@ -27,8 +27,9 @@ std::vector<ics_found> ics_scan(ics_link& l, std::span<const std::uint32_t> baud
     bool heard = false;
     for (int t = 0; t < std::max(1, o.tries) && !heard; ++t) {  // tried as every exchange is (docs/ics-servos.md)
       const auto rx = l.transact(probe.view(), probe.size + 1, wait_for(probe.size + 1, b, o.timeout));
+      const bool damaged = l.last_damaged();  // something answered, damaged: its IDs are asked one by one
       const auto late = l.linger(o.timeout);
-      heard = rx.size() > probe.size || !late.empty();
+      heard = rx.size() > probe.size || damaged || !late.empty();
       echoed = echoed || !rx.empty() || !late.empty();
     }
     if (!heard) continue;

@@ -6,6 +6,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -161,4 +162,60 @@ TEST_CASE("ics EEPROM: a backup outside rcb4's ranges goes back with --force, as
   CHECK(again.written);
   CHECK_FALSE(s.read_eeprom().stored_odd(field::stretch_1));
   CHECK(s.read_eeprom().get(field::stretch_1) == 50);
+}
+
+namespace {
+/**
+ * A line whose transacts listed in @p damaged (0: the first) stop at a byte that failed its parity
+ * check, as rcb4::transport::ics_port reports it on a marked line: the bytes before it, and
+ * last_damaged() true. With @p always, every transact does.
+ */
+struct damaging_link final : ics_link {
+  ics_virtual_link inner{ics::virtual_line({ics::virtual_servo(id_of(0), 115200, 1)})};
+  std::vector<int> damaged;
+  bool always = false;
+  int n = 0;
+  bool last = false;
+  std::vector<std::uint8_t> transact(std::span<const std::uint8_t> request, std::size_t expect,
+                                     std::chrono::milliseconds wait) override {
+    auto rx = inner.transact(request, expect, wait);
+    const int k = n++;
+    last = always || std::find(damaged.begin(), damaged.end(), k) != damaged.end();
+    if (last && rx.size() > request.size()) rx.resize(request.size() + 1);  // echo and one good byte, then the damage
+    return rx;
+  }
+  std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) override {
+    last = false;
+    return inner.linger(wait);
+  }
+  bool last_damaged() const override { return last; }
+  void set_baud(std::uint32_t baud) override { inner.set_baud(baud); }
+  std::uint32_t baud() const override { return inner.baud(); }
+};
+}  // namespace
+
+TEST_CASE("ics: a reply with a damaged byte is tried again and never used, and every try damaged is refused", "[ics]") {
+  damaging_link l;
+  ics_servo s(l, id_of(0), {});
+  const auto truth = s.read(ics::sub::stretch);
+  l.n = 0;
+  l.damaged = {0};
+  CHECK(s.read(ics::sub::stretch) == truth);  // the second try's answer
+  CHECK(l.n == 2);
+
+  l.always = true;
+  try {
+    (void)s.read(ics::sub::stretch);
+    FAIL("a reply damaged at every try was used");
+  } catch (const refused& r) {
+    CHECK(r.kind == refusal_kind::board);
+    CHECK(std::string(r.what()).find("failed its parity check") != std::string::npos);
+  }
+  try {
+    (void)s.read_id(false);
+    FAIL("a damaged ID reply was used");
+  } catch (const refused& r) {
+    CHECK(r.kind == refusal_kind::board);
+    CHECK(std::string(r.what()).find("failed its parity check") != std::string::npos);
+  }
 }

@@ -41,6 +41,7 @@ enum class transport_errc {
   executor_not_running,  ///< a blocking call waited for the executor, and nobody ran it
   echo,                  ///< the line echoes what is sent (a loopback plug, not a board)
   truncated,             ///< a reply began but stopped short of its length before the deadline
+  line_error,            ///< a byte of the reply failed its parity or framing check (noise, wrong rate, a break)
 };
 
 }  // namespace rcb4::transport
@@ -73,6 +74,8 @@ class transport_category_impl final : public std::error_category {
         return "nobody runs the client's executor (run it on another thread, e.g. io_thread)";
       case transport_errc::echo: return "the line echoes what is sent: a loopback, not an RCB-4";
       case transport_errc::truncated: return "the board's reply stopped short of its length before the deadline";
+      case transport_errc::line_error:
+        return "a byte of the reply failed its parity or framing check (a noisy line, a wrong rate, or a break)";
     }
     return "unknown rcb4.transport error";
   }

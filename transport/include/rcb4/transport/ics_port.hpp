@@ -8,6 +8,7 @@
 // Robot services reach it through services::ics_port_link (rcb4/robot/services/ics.hpp).
 #pragma once
 
+#include <rcb4/transport/line_marks.hpp>
 #include <rcb4/transport/serial.hpp>
 
 #include <poll.h>
@@ -28,15 +29,25 @@ class ics_port {
     boost::asio::io_context io;
     auto port = open_serial(io, path, baud, &info_);
     fd_ = port.release();
+    marked_ = detail::is_marked(fd_);
   }
-  ics_port(ics_port&& o) noexcept : path_(std::move(o.path_)), baud_(o.baud_), info_(o.info_), fd_(o.fd_) {
+  ics_port(ics_port&& o) noexcept
+      : path_(std::move(o.path_)),
+        baud_(o.baud_),
+        info_(o.info_),
+        fd_(o.fd_),
+        marked_(o.marked_),
+        marks_(o.marks_),
+        damaged_(o.damaged_) {
     o.fd_ = -1;
   }
   ics_port& operator=(ics_port&&) = delete;
   ics_port(const ics_port&) = delete;
   ics_port& operator=(const ics_port&) = delete;
   ~ics_port() {
-    if (fd_ >= 0) ::close(fd_);
+    if (fd_ < 0) return;
+    if (marked_) detail::unmark(fd_);
+    ::close(fd_);
   }
 
   /** What was opened. */
@@ -56,7 +67,14 @@ class ics_port {
       throw system_error(ec, "set baud of " + path_);
     }
     baud_ = baud;
+    marked_ = detail::is_marked(fd_);
   }
+
+  /**
+   * True when the last transact() or linger() stopped at a byte that failed its parity or
+   * framing check (what they returned are the bytes before it).
+   */
+  bool damaged() const noexcept { return damaged_; }
 
   /**
    * Sends @p request and reads until @p expect bytes came back (echo and reply) or @p wait passed:
@@ -66,6 +84,7 @@ class ics_port {
                                      std::chrono::milliseconds wait) {
     const auto deadline = std::chrono::steady_clock::now() + wait;
     ::tcflush(fd_, TCIFLUSH);
+    marks_.reset();  // (a mark the flush cut in half is gone with it)
     std::size_t sent = 0;
     while (sent < request.size()) {
       if (!ready(POLLOUT, deadline)) throw system_error(transport_errc::timeout, "write to " + path_);
@@ -102,19 +121,34 @@ class ics_port {
     }
   }
   void read_until(std::vector<std::uint8_t>& rx, std::size_t expect, std::chrono::steady_clock::time_point deadline) {
+    damaged_ = false;
     std::uint8_t buf[256];
     while (rx.size() < expect && ready(POLLIN, deadline)) {
       const auto n = ::read(fd_, buf, sizeof buf);
       if (n == 0 || (n < 0 && (errno == EIO || errno == ENXIO || errno == ENODEV)))
         throw system_error(transport_errc::closed, path_);
       if (n < 0 && errno != EAGAIN && errno != EINTR) throw system_error(os_error(errno), "read " + path_);
-      if (n > 0) rx.insert(rx.end(), buf, buf + n);
+      if (n <= 0) continue;
+      auto size = static_cast<std::size_t>(n);
+      if (marked_) {
+        const auto d = marks_.decode(std::span(buf, size));
+        if (d.damaged > 0) {  // the bytes before the first damaged one, and no more
+          damaged_ = true;
+          rx.insert(rx.end(), buf, buf + d.first_damaged);
+          return;
+        }
+        size = d.size;
+      }
+      rx.insert(rx.end(), buf, buf + size);
     }
   }
   std::string path_;
   std::uint32_t baud_;
   serial_info info_{};
   int fd_ = -1;
+  bool marked_ = false;  // reads are PARMRK-marked (open_serial sets it; a pty's slave keeps it)
+  line_marks marks_{};
+  bool damaged_ = false;
 };
 
 }  // namespace rcb4::transport

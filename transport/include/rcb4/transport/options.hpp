@@ -62,15 +62,16 @@ struct reconnect_policy {
 
 /** What a client has done (readable from any thread). */
 struct client_counters {
-  std::atomic<std::uint64_t> exchanges{0};   ///< requests completed (success or not)
-  std::atomic<std::uint64_t> retries{0};     ///< extra attempts
-  std::atomic<std::uint64_t> timeouts{0};    ///< deadlines missed (a resync's included)
-  std::atomic<std::uint64_t> errors{0};      ///< exchanges that ended in an error (a NACK is not one)
-  std::atomic<std::uint64_t> nacks{0};       ///< replies that were NACK
-  std::atomic<std::uint64_t> resyncs{0};     ///< resynchronisations (ping, discard to its ACK) after an error
-  std::atomic<std::uint64_t> bytes_out{0};   ///< bytes written
-  std::atomic<std::uint64_t> bytes_in{0};    ///< bytes read (discarded bytes included)
-  std::atomic<std::uint64_t> reconnects{0};  ///< links reopened after a loss
+  std::atomic<std::uint64_t> exchanges{0};    ///< requests completed (success or not)
+  std::atomic<std::uint64_t> retries{0};      ///< extra attempts
+  std::atomic<std::uint64_t> timeouts{0};     ///< deadlines missed (a resync's included)
+  std::atomic<std::uint64_t> errors{0};       ///< exchanges that ended in an error (a NACK is not one)
+  std::atomic<std::uint64_t> nacks{0};        ///< replies that were NACK
+  std::atomic<std::uint64_t> resyncs{0};      ///< resynchronisations (ping, discard to its ACK) after an error
+  std::atomic<std::uint64_t> bytes_out{0};    ///< bytes written
+  std::atomic<std::uint64_t> bytes_in{0};     ///< bytes read (discarded bytes included)
+  std::atomic<std::uint64_t> reconnects{0};   ///< links reopened after a loss
+  std::atomic<std::uint64_t> line_errors{0};  ///< bytes that failed their parity or framing check (a marked line)
 };
 
 }  // namespace rcb4::transport

@@ -65,14 +65,16 @@ constexpr bool rate_close(std::uint32_t got, std::uint32_t want) noexcept {
 /**
  * The RCB-4's line (protocol.md §1) on top of @p t: 8 data bits, even parity, 1 stop bit, raw
  * (no echo, no line editing, no translations, no flow control), receiver on, modem lines
- * ignored, parity checked (a bad byte reads as 0: the frame's checksum then rejects it), the rate
- * @p baud as an arbitrary rate (BOTHER) for input and output, and reads that wait for one byte
- * (VMIN 1, VTIME 0: with VMIN 0 an empty non-blocking read returns 0, as at end of file).
+ * ignored, parity checked and a damaged byte marked (INPCK + PARMRK: FF 00 X, and an intact FF
+ * doubled; line_marks.hpp decodes it: without PARMRK Linux would hand the byte over as 0x00, a
+ * valid value), the rate @p baud as an arbitrary rate (BOTHER) for input and output, and reads
+ * that wait for one byte (VMIN 1, VTIME 0: with VMIN 0 an empty non-blocking read returns 0, as
+ * at end of file).
  */
 inline void make_rcb4_line(kernel_termios2& t, std::uint32_t baud) noexcept {
-  t.c_iflag &= ~static_cast<tcflag_t>(IGNBRK | BRKINT | PARMRK | ISTRIP | INLCR | IGNCR | ICRNL | IXON | IXOFF | IXANY |
-                                      IGNPAR | IUCLC | IMAXBEL);
-  t.c_iflag |= INPCK;
+  t.c_iflag &= ~static_cast<tcflag_t>(IGNBRK | BRKINT | ISTRIP | INLCR | IGNCR | ICRNL | IXON | IXOFF | IXANY | IGNPAR |
+                                      IUCLC | IMAXBEL);
+  t.c_iflag |= INPCK | PARMRK;
   t.c_oflag &= ~static_cast<tcflag_t>(OPOST);
   t.c_lflag &= ~static_cast<tcflag_t>(ECHO | ECHOE | ECHOK | ECHONL | ICANON | ISIG | IEXTEN);
   t.c_cflag &=
@@ -81,6 +83,27 @@ inline void make_rcb4_line(kernel_termios2& t, std::uint32_t baud) noexcept {
   t.c_ispeed = t.c_ospeed = baud;
   t.c_cc[VMIN] = 1;
   t.c_cc[VTIME] = 0;
+}
+
+/** True when input flags @p iflag mark a damaged byte and double an intact 0xFF (line_marks.hpp). */
+constexpr bool iflag_marks(tcflag_t iflag) noexcept { return (iflag & PARMRK) != 0 && (iflag & ISTRIP) == 0; }
+
+/** True when the terminal @p fd marks damaged bytes (iflag_marks): its reads go through line_marks. */
+inline bool is_marked(int fd) noexcept {
+  kernel_termios2 t{};
+  return ::ioctl(fd, tcgets2, &t) == 0 && iflag_marks(t.c_iflag);
+}
+
+/**
+ * Takes the marks off @p fd's input (PARMRK), as a program that is done with the port leaves it:
+ * a terminal keeps its settings after the last close, and a program that opens it next without
+ * clearing PARMRK (Python's tty.setraw does not) would read each FF twice. Best effort.
+ */
+inline void unmark(int fd) noexcept {
+  kernel_termios2 t{};
+  if (::ioctl(fd, tcgets2, &t) != 0 || (t.c_iflag & PARMRK) == 0) return;
+  t.c_iflag &= ~static_cast<tcflag_t>(PARMRK);
+  (void)::ioctl(fd, tcsets2, &t);
 }
 
 /**
@@ -100,7 +123,8 @@ inline error_code set_rcb4_line(int fd, std::uint32_t baud, std::uint32_t& rate,
   parity = (back.c_cflag & PARENB) != 0 && (back.c_cflag & PARODD) == 0;
   if (!rate_close(back.c_ospeed, baud)) return transport_errc::rate_not_set;
   const bool raw = (back.c_lflag & (ICANON | ECHO | ISIG | IEXTEN)) == 0 && (back.c_oflag & OPOST) == 0 &&
-                   (back.c_iflag & (IXON | IXOFF | ICRNL | INLCR | IGNCR | ISTRIP)) == 0;
+                   (back.c_iflag & (IXON | IXOFF | ICRNL | INLCR | IGNCR | ISTRIP | IGNPAR)) == 0 &&
+                   iflag_marks(back.c_iflag);
   const bool frame = (back.c_cflag & CSIZE) == CS8 && (back.c_cflag & CSTOPB) == 0 && (back.c_cflag & CRTSCTS) == 0;
   if (!raw || !frame || back.c_cc[VMIN] != 1 || back.c_cc[VTIME] != 0) return transport_errc::settings_not_kept;
   return {};

@@ -45,6 +45,11 @@ class ics_link {
                                              std::chrono::milliseconds wait) = 0;
   /** The bytes that arrive within @p wait (a late reply, a second device); then the line is quiet. */
   virtual std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) = 0;
+  /**
+   * True when the last transact() or linger() stopped at a byte that failed its parity or framing
+   * check (the bytes returned are those before it): never data (serial.hpp marks such bytes).
+   */
+  virtual bool last_damaged() const { return false; }
   /** Talks at @p baud from now on. */
   virtual void set_baud(std::uint32_t baud) = 0;
   /** The rate in use. */
@@ -194,6 +199,12 @@ class ics_port_link final : public ics_link {
     return p_.transact(request, expect, wait);
   }
   std::vector<std::uint8_t> linger(std::chrono::milliseconds wait) override { return p_.linger(wait); }
+  bool last_damaged() const override {
+    if constexpr (requires(const Port& q) { q.damaged(); })
+      return p_.damaged();
+    else
+      return false;
+  }
   void set_baud(std::uint32_t baud) override { p_.set_baud(baud); }
   std::uint32_t baud() const override { return p_.baud(); }
 

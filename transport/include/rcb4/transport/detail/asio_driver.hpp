@@ -55,6 +55,7 @@ class asio_driver {
   task<error_code> run(Stream& s, exchange_machine& m, const request& req, const reopen_function& reopen,
                        std::size_t stray) {
     aborted_.reset();
+    m.set_marked(marked(s));
     auto a = m.start(req, clock::now(), stray);
     for (;;) {
       // (the I/O is awaited here, not in nested coroutines: each nesting costs a frame and two
@@ -83,7 +84,10 @@ class asio_driver {
           r = finish_io(n, e);
           break;
         }
-        case action::kind::reopen: r = co_await reopen_line(s, a.deadline, reopen); break;
+        case action::kind::reopen:
+          r = co_await reopen_line(s, a.deadline, reopen);
+          if (!r.ec) m.set_marked(marked(s));
+          break;
         case action::kind::done: co_return a.ec;
       }
       a = aborted_ ? m.cancel(*aborted_) : m.resume(r, clock::now());
@@ -96,6 +100,8 @@ class asio_driver {
     cancel_.emit(boost::asio::cancellation_type::terminal);
     backoff_.cancel();
   }
+  /** The stream's descriptor may have been replaced or set up anew (call while the worker is idle). */
+  void forget() noexcept { checked_fd_ = marks_fd_ = -1; }
   /** Stops the timers (call on the strand, or when nothing else can touch them). */
   void stop() {
     ++generation_;
@@ -148,7 +154,7 @@ class asio_driver {
     }
     if (aborted_) co_return io_result{};
     error_code ec;
-    checked_fd_ = -1;  // a new descriptor, maybe with the old number
+    checked_fd_ = marks_fd_ = -1;  // a new descriptor, maybe with the old number
     reopen(s, ec);
     co_return io_result{0, ec};
   }
@@ -165,6 +171,21 @@ class asio_driver {
     s.async_wait(wait_write(), boost::asio::detached);
     s.native_non_blocking(true);
   };
+  /** Whether the stream's reads are PARMRK-marked (a serial line open_serial set up): once per descriptor. */
+  bool marked(Stream& s) {
+    if constexpr (posix_driver<Stream>::has_descriptor) {
+      const int fd = s.native_handle();
+      if (fd != marks_fd_) {
+        marks_fd_ = fd;
+        fd_marked_ = fd >= 0 && !posix_driver<Stream>::is_socket && !is_socket_fd(fd) && is_marked_tty(fd);
+      }
+      return fd_marked_;
+    } else {
+      (void)s;
+      return false;
+    }
+  }
+
   /** Once per descriptor: non-blocking (so a direct write never blocks), and whether it is a socket. */
   bool prepare(Stream& s, int fd) {
     if (fd != checked_fd_) {
@@ -229,6 +250,8 @@ class asio_driver {
   std::uint64_t generation_ = 0;       // that wait's number: completions of replaced waits are stale
   int checked_fd_ = -1;                // the descriptor prepared (non-blocking; fd_socket_ says what it is)
   bool fd_socket_ = false;
+  int marks_fd_ = -1;       // the descriptor whose marking fd_marked_ says
+  bool fd_marked_ = false;  // its reads are PARMRK-marked
 };
 
 }  // namespace rcb4::transport::detail

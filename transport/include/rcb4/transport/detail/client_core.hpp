@@ -139,6 +139,7 @@ class client_core : public std::enable_shared_from_this<client_core<Stream>> {
     if (!busy_) {
       direct_.unpark(stream_);
       direct_.forget();  // the caller may change the descriptor's settings
+      asio_.forget();
     }
     return stream_;
   }

@@ -24,7 +24,10 @@
 //   unless `retry_writes`;
 // - a lost link (EOF, EIO, ENODEV ...) is reopened before the next attempt when the client can
 //   reopen it, with a backoff from `first_delay` doubling to `max_delay`, for `give_up_after`;
-// - a reply that is the request's own bytes coming back is a loopback, not a board.
+// - a reply that is the request's own bytes coming back is a loopback, not a board;
+// - on a marked serial line (PARMRK, what open_serial sets) the bytes read are decoded
+//   (line_marks.hpp): a byte that failed its parity or framing check fails the attempt at once
+//   (line_error: resync, and retry if allowed), it never becomes data.
 // A well-formed reply ends the exchange without error, a NACK included: the client decides what
 // a NACK means for its caller (see basic_client::execute and exchange).
 #pragma once
@@ -32,6 +35,7 @@
 #include <rcb4/rcb4.hpp>
 #include <rcb4/transport/detail/exchange.hpp>
 #include <rcb4/transport/error.hpp>
+#include <rcb4/transport/line_marks.hpp>
 #include <rcb4/transport/options.hpp>
 #include <rcb4/transport/response.hpp>
 
@@ -75,6 +79,17 @@ class exchange_machine {
  public:
   /** A machine using @p opt (read as it goes: change them only while no exchange runs). */
   exchange_machine(const client_options& opt, client_counters& counters) noexcept : opt_(&opt), n_(&counters) {}
+
+  /**
+   * Whether the line's reads are marked (PARMRK: a damaged byte as FF 00 X, an intact FF doubled)
+   * and must be decoded. The drivers tell it for each descriptor; a change starts the decoder clean.
+   */
+  void set_marked(bool marked) noexcept {
+    if (marked != marked_) marks_.reset();
+    marked_ = marked;
+  }
+  /** True while the line's reads are decoded as marked. */
+  bool marked() const noexcept { return marked_; }
 
   /** Whether a lost link can be reopened (a reopen function is set), and with which policy. */
   void set_reopen(bool can, reconnect_policy policy = {}) noexcept {
@@ -129,7 +144,10 @@ class exchange_machine {
   /** True when the link was lost (the next exchange reopens it first, when it can). */
   bool lost() const noexcept { return lost_; }
   /** The link was replaced from outside (a new stream): it starts clean. */
-  void replaced() noexcept { dirty_ = lost_ = false; }
+  void replaced() noexcept {
+    dirty_ = lost_ = false;
+    marks_.reset();
+  }
   /** The running attempt's deadline (while an exchange runs). */
   clock::time_point deadline() const noexcept { return deadline_; }
 
@@ -172,6 +190,26 @@ class exchange_machine {
     return a;
   }
 
+  /**
+   * The first @p n bytes of @p buf as read: on a marked line they are decoded in place. Returns
+   * the data bytes' count; @p d says what was damaged (nothing on an unmarked line).
+   */
+  std::size_t decode(std::span<std::uint8_t> buf, std::size_t n, line_marks::decoded& d) {
+    n = std::min(n, buf.size());
+    n_->bytes_in += n;
+    if (!marked_) {
+      d = line_marks::decoded{};
+      d.size = n;
+      return n;
+    }
+    d = marks_.decode(buf.first(n));
+    if (d.damaged > 0) n_->line_errors += d.damaged;
+    return d.size;
+  }
+
+  /** A byte of a reply arrived damaged: the attempt fails (resync, and a retry where allowed). */
+  action damaged(clock::time_point now) { return attempt_failed(transport_errc::line_error, now); }
+
   action begin_attempt(clock::time_point now) {
     if (attempt_ > 0) ++n_->retries;
     if (lost_ && can_reopen_) {  // (without a reopen, the attempt tries the line as it is: the OS says if it is gone)
@@ -207,6 +245,7 @@ class exchange_machine {
   action reopened(const io_result& r, clock::time_point now) {
     if (!r.ec) {
       lost_ = dirty_ = false;
+      marks_.reset();  // a new descriptor (the driver says whether it is marked)
       ++n_->reconnects;
       return begin_exchange(now);
     }
@@ -232,10 +271,11 @@ class exchange_machine {
   }
 
   action sync_read(const io_result& r, clock::time_point now) {
-    const std::size_t n = std::min(r.n, junk_.size());
-    n_->bytes_in += n;
+    line_marks::decoded d;
+    const std::size_t n = decode(junk_, r.n, d);
     trace(direction::rx, now, std::span(junk_).first(n));
-    for (std::size_t i = 0; i < n; ++i) {
+    if (d.damaged > 0) sync_ = sync_state{};  // an ACK with a damaged byte is no ACK: look for the next
+    for (std::size_t i = d.clean_from; i < n; ++i) {
       std::rotate(sync_.tail.begin(), sync_.tail.begin() + 1, sync_.tail.end());
       sync_.tail.back() = junk_[i];
       ++sync_.seen;
@@ -281,10 +321,11 @@ class exchange_machine {
   action read(const io_result& r, clock::time_point now) {
     if (r.n > 0) {
       const auto buf = ex_->read_buffer();
-      const std::size_t n = std::min(r.n, buf.size());
-      n_->bytes_in += n;
+      line_marks::decoded d;
+      const std::size_t n = decode(buf, r.n, d);
       trace(direction::rx, now, buf.first(n));
-      ex_->received(n);
+      if (d.damaged > 0) return damaged(now);  // (never more is read than the reply can hold: it is this reply's)
+      if (n > 0) ex_->received(n);
     }
     if (ex_->next() == exchange::step::done) return judge(now);
     if (r.timed_out) return ex_->received_bytes().empty() ? timed_out(now) : truncated(now);
@@ -318,9 +359,10 @@ class exchange_machine {
 
   action echo_check(const io_result& r, clock::time_point now) {
     const auto sent = req_.frame.bytes();
-    const std::size_t n = std::min(r.n, sent.size() - echo_.matched);
-    n_->bytes_in += n;
+    line_marks::decoded d;
+    const std::size_t n = decode(echo_buffer(), r.n, d);
     trace(direction::rx, now, std::span(junk_).first(n));
+    if (d.damaged > 0) return damaged(now);
     if (!std::equal(junk_.begin(), junk_.begin() + static_cast<std::ptrdiff_t>(n),
                     sent.begin() + static_cast<std::ptrdiff_t>(echo_.matched)))
       return attempt_failed(echo_.error, now);  // not our frame after all: the malformed reply it was
@@ -390,6 +432,8 @@ class exchange_machine {
   bool can_reopen_ = false;
   reconnect_policy policy_{};
   // the line, between exchanges
+  bool marked_ = false;
+  line_marks marks_{};
   bool dirty_ = false;
   bool lost_ = false;
   // the running exchange

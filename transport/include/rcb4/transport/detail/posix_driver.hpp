@@ -70,6 +70,16 @@ inline bool is_bounded_tty(int fd) noexcept {
   return ::isatty(fd) == 1 && ::ioctl(fd, TIOCGPTN, &pty_number) != 0;
 }
 
+/**
+ * True when @p fd is a terminal that marks a damaged byte and doubles an intact 0xFF (PARMRK
+ * without ISTRIP: what open_serial sets, serial.hpp): its reads are decoded (line_marks.hpp).
+ * Not a pseudo-terminal's master side, whose reads are the slave's output, never marked.
+ */
+inline bool is_marked_tty(int fd) noexcept {
+  termios t{};
+  return is_bounded_tty(fd) && ::tcgetattr(fd, &t) == 0 && (t.c_iflag & PARMRK) != 0 && (t.c_iflag & ISTRIP) == 0;
+}
+
 /** Runs exchanges on the calling thread over the descriptor of a @p Stream. */
 template <class Stream>
 class posix_driver {
@@ -91,6 +101,7 @@ class posix_driver {
   error_code run(Stream& s, exchange_machine& m, const client_options& opt, const request& req,
                  const reopen_function& reopen) {
     park(s);
+    m.set_marked(marked(s));
     const auto stray = bytes_waiting(s);
     auto a = m.start(req, clock::now(), stray);
     for (;;) {
@@ -98,10 +109,23 @@ class posix_driver {
       switch (a.what) {
         case action::kind::write: r = write_before(s, a); break;
         case action::kind::read: r = read_before(s, a, opt); break;
-        case action::kind::reopen: r = reopen_line(s, a.deadline, reopen); break;
+        case action::kind::reopen:
+          r = reopen_line(s, a.deadline, reopen);
+          if (!r.ec) m.set_marked(marked(s));
+          break;
         case action::kind::done: return a.ec;
       }
       a = m.resume(r, clock::now());
+    }
+  }
+
+  /** Whether the stream's reads are marked (a serial line open_serial set up): once per descriptor. */
+  bool marked(Stream& s) {
+    if constexpr (has_descriptor) {
+      return line_fd(s) >= 0 && fd_.marked;
+    } else {
+      (void)s;
+      return false;
     }
   }
 
@@ -168,10 +192,16 @@ class posix_driver {
     if constexpr (has_descriptor) {
       const int fd = line_fd(s);
       if (fd >= 0 && ::isatty(fd) == 1) ::ioctl(fd, TIOCNXCL);
-      termios t{};  // reads as open_serial left them (VMIN 1), not as the bounded reads set them
-      if (fd >= 0 && fd_.fd == fd && fd_.vtime != 0 && ::tcgetattr(fd, &t) == 0) {
-        t.c_cc[VMIN] = 1;
-        t.c_cc[VTIME] = 0;
+      // Reads as open_serial left them (VMIN 1), not as the bounded reads set them; and unmarked:
+      // a terminal keeps its settings after the last close, and a program that opens it next
+      // without clearing PARMRK (Python's tty.setraw does not) would read each FF twice.
+      termios t{};
+      if (fd >= 0 && fd_.fd == fd && (fd_.vtime != 0 || fd_.marked) && ::tcgetattr(fd, &t) == 0) {
+        if (fd_.vtime != 0) {
+          t.c_cc[VMIN] = 1;
+          t.c_cc[VTIME] = 0;
+        }
+        if (fd_.marked) t.c_iflag &= ~static_cast<tcflag_t>(PARMRK);
         ::tcsetattr(fd, TCSANOW, &t);  // (best effort: the descriptor is going)
       }
     }
@@ -193,6 +223,7 @@ class posix_driver {
     bool socket = false;    // a socket (maybe wrapped as a plain descriptor): written with send()
     cc_t vtime = 0;         // the VTIME last set (VMIN is 0 once any is set)
     bool blocking = false;  // O_NONBLOCK is off (left so by bounded reads until unpark)
+    bool marked = false;    // reads are PARMRK-marked (is_marked_tty)
   };
 
   /** The line's descriptor, parked or in the stream; made non-blocking once per descriptor. */
@@ -203,6 +234,7 @@ class posix_driver {
     if (fd < 0) fd = s.native_handle();
     if (fd >= 0 && fd != fd_.fd) {
       fd_ = descriptor{fd, ::fcntl(fd, F_GETFL), !is_socket && is_bounded_tty(fd), is_socket || is_socket_fd(fd)};
+      fd_.marked = !fd_.socket && is_marked_tty(fd);
       if (fd_.flags >= 0 && (fd_.flags & O_NONBLOCK) == 0) ::fcntl(fd, F_SETFL, fd_.flags | O_NONBLOCK);
       fd_.flags |= O_NONBLOCK;
     }
