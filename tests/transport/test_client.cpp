@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <thread>
 
 using namespace rcb4;
@@ -543,6 +544,22 @@ TEST_CASE("client: operations run on the client, baud detection, bad addresses",
   CHECK(states.size() == 20);
   auto fut = boost::asio::co_spawn(io.context(), t::async_run(c, ops::read_motion_state{}), boost::asio::use_future);
   CHECK_FALSE(fut.get().running);
+  // Any completion token: a callback, a future, deferred; the operation's own error arrives as the code.
+  std::promise<std::pair<t::error_code, std::size_t>> called;
+  t::async_run(c, ops::read_servo_states{}, [&](t::error_code e, auto s) { called.set_value({e, s.size()}); });
+  const auto [called_ec, called_n] = called.get_future().get();
+  CHECK_FALSE(called_ec);
+  CHECK(called_n == 20);
+  auto version_fut = t::async_run(c, ops::read_version{}, boost::asio::use_future);
+  CHECK_FALSE(version_fut.get().empty());
+  std::promise<std::pair<t::error_code, bool>> refused;  // (no Catch assertion off the test's thread)
+  t::async_run(c, ops::read_memory(ops::memory::ram, 0x0480, 32),
+               boost::asio::deferred)([&](t::error_code e, const std::vector<std::uint8_t>& data) {
+    refused.set_value({e, data.empty()});
+  });
+  const auto [refused_ec, no_data] = refused.get_future().get();
+  CHECK(refused_ec == rcb4::errc::ram_address_out_of_range);
+  CHECK(no_data);  // no partial value with an error
   ops::read_memory bad(ops::memory::ram, 0x0480, 32);
   t::run(c, bad, ec);
   CHECK(ec == rcb4::errc::ram_address_out_of_range);

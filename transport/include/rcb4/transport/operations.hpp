@@ -3,6 +3,9 @@
 //
 //   auto states = rcb4::transport::run(client, rcb4::ops::read_servo_states{});       // throws
 //   auto s = co_await rcb4::transport::async_run(client, rcb4::ops::read_analog{});   // coroutine
+//   rcb4::transport::async_run(client, rcb4::ops::read_analog{},                      // any token:
+//       [](rcb4::transport::error_code ec, auto values) { ... });                     // a callback,
+//   auto f = rcb4::transport::async_run(client, op, boost::asio::use_future);        // a future, ...
 #pragma once
 
 #include <rcb4/ops.hpp>
@@ -11,6 +14,7 @@
 
 #include <boost/asio/awaitable.hpp>
 #include <boost/asio/co_spawn.hpp>
+#include <boost/asio/compose.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <boost/asio/use_future.hpp>
 
@@ -68,6 +72,46 @@ template <AsyncByteStream Stream, ops::Operation Op>
 boost::asio::awaitable<std::decay_t<decltype(std::declval<Op&>().value())>> async_run(basic_client<Stream>& c, Op op) {
   if (const auto ec = co_await detail::async_run_ec(c, op)) throw system_error(ec, "rcb4 operation");
   co_return op.value();
+}
+
+namespace detail {
+/** async_run's composed operation: each step's exchange, then the next, on the client's executor. */
+template <class Stream, class Op>
+struct run_composed {
+  using value_type = std::decay_t<decltype(std::declval<Op&>().value())>;
+  basic_client<Stream>* client;
+  Op op;
+  bool waiting = false;  // an exchange of op's is under way: the call is its completion
+
+  template <class Self>
+  void operator()(Self& self, error_code ec = {}, response r = {}) {
+    if (waiting) {
+      waiting = false;
+      if (ec) return self.complete(ec, value_type{});  // the line failed, or the reply was malformed
+      op.on_reply(r.view());                           // a NACK is the operation's to judge
+    }
+    if (auto cmd = op.next()) {
+      waiting = true;
+      client->async_exchange(*cmd, std::move(self));
+      return;
+    }
+    if (op.error() != rcb4::errc{}) return self.complete(error_code(op.error()), value_type{});
+    self.complete(error_code{}, value_type(op.value()));
+  }
+};
+}  // namespace detail
+
+/**
+ * Runs @p op on @p c and completes with (error_code, the operation's value) through any
+ * completion token: a callback, use_future, deferred, use_awaitable (as_tuple to get the code
+ * without an exception). On an error the value is value-initialised, never a partial result.
+ * The token's cancellation slot reaches the exchange under way (basic_client::async_execute).
+ */
+template <AsyncByteStream Stream, ops::Operation Op, class Token>
+auto async_run(basic_client<Stream>& c, Op op, Token&& token) {
+  using value_type = typename detail::run_composed<Stream, Op>::value_type;
+  return boost::asio::async_compose<Token, void(error_code, value_type)>(
+      detail::run_composed<Stream, Op>{&c, std::move(op)}, token, c.get_executor());
 }
 
 /**
