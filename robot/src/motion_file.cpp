@@ -238,10 +238,30 @@ motion_document parse_motion_nodes(std::string_view text, const std::string& sou
   if (!steps || !steps.IsSequence() || steps.size() == 0)
     throw profile_error(where(source, steps ? steps.Mark() : root.Mark()),
                         "steps: expected a list of steps, the last an end or a goto");
-  for (const auto& s : steps) {
+  bool any_view = false;
+  std::vector<step_view> views;
+  for (auto s : steps) {
+    step_view v;
+    if (s.IsMap()) {  // how the studio shows the step: read, then out of the way of the step's own keys
+      if (s["name"]) {
+        v.name = scalar(source, s["name"], "name");
+        if (v.name.size() > 80) fail(source, s["name"], "name: at most 80 characters");
+        s.remove("name");
+      }
+      if (const YAML::Node at = s["at"]) {
+        if (!at.IsSequence() || at.size() != 2)
+          fail(source, at, "at: the flowchart block's place, [x, y] in pixels (0..100000)");
+        v.at =
+            std::array<long, 2>{integer(source, at[0], "at: x", 0, 100000), integer(source, at[1], "at: y", 0, 100000)};
+        s.remove("at");
+      }
+    }
+    any_view = any_view || v != step_view{};
+    views.push_back(std::move(v));
     d.steps.push_back(parse_step(source, s, m, dir));
     d.where.push_back(s.Mark().is_null() ? source : source + ":" + std::to_string(s.Mark().line + 1));
   }
+  if (any_view) d.views = std::move(views);
   return d;
 }
 

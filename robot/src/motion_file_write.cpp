@@ -118,8 +118,15 @@ std::string motion_yaml(const motion_document& d, std::string_view comment) {
   if (!d.name.empty()) out += "name: " + yaml_quoted(d.name) + "\n";
   out += "period_ms: " + std::to_string(milliseconds(d.period)) + "\n";
   out += "steps:\n";
-  for (const auto& s : d.steps) {
-    const std::string text = step_yaml(s);
+  for (std::size_t k = 0; k < d.steps.size(); ++k) {
+    const auto& s = d.steps[k];
+    std::string text = step_yaml(s);
+    // How the studio shows it (not for end, which is a bare word).
+    if (k < d.views.size() && !std::holds_alternative<motion::end>(s)) {
+      const auto& v = d.views[k];
+      if (!v.name.empty()) text += "  name: " + yaml_quoted(v.name) + "\n";
+      if (v.at) text += "  at: [" + std::to_string((*v.at)[0]) + ", " + std::to_string((*v.at)[1]) + "]\n";
+    }
     // Every line of the step indented under "steps:".
     std::size_t at = 0;
     while (at < text.size()) {

@@ -149,6 +149,10 @@ with serve() as dev:
             y = f.read() if rc == 0 else ""
         check(rc == 0 and "set_counter: 2" in y and "count_down:" in y and "period_ms: 15" in y,
               f"motion import {name}: a motion file ({rc}: {err.strip()!r} {y[:200]!r})")
+        # Each block's place on HTH4's canvas and its name ride on the step its code starts with.
+        check('name: "Pos2"\n    at: [8, 96]' in y and 'name: "SetCounter1"\n    at: [8, 16]' in y
+              and 'name: "Pos4"\n    at: [8, 256]' in y,
+              f"motion import {name}: the blocks' names and places kept ({y!r})")
     rc, out, err = run(*on, "motion", "push", "wave_twice.xml.yaml", "20", "--backup", "twenty.bin")
     rc2, out2, err2 = run(*on, "motion", "import", os.path.join(DATA, "wave_twice.xml"), "--push", "21", "--backup", "t1.bin")
     # The same motion at slots 20 and 21: the same bytes but for the jump targets (slot 20 vs 21).

@@ -9,6 +9,7 @@
 # SPDX-License-Identifier: BSL-1.0
 import json
 import os
+import re
 import sys
 import tempfile
 import time
@@ -275,6 +276,41 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         rc, out, err = run("--device", dev, "motion", "show", "13")
         check(rc == 0 and out.count("CONST 20 servos") == 2, f"rcb4 motion show 13 lists it ({rc}, {out[:200]!r}, {err.strip()!r})")
 
+        # The layout and the names are kept in the motion file: a block dragged, a pose named, the
+        # file saved (the tool's motion_check: the YAML a download holds) and opened again.
+        js(driver, """const svg = document.getElementById('ed-flow');
+            const b = svg.querySelector('.flow-block[data-step="2"]').getBoundingClientRect();
+            const at = (x, y) => ({ bubbles: true, pointerId: 1, clientX: x, clientY: y });
+            svg.dispatchEvent(new PointerEvent('pointerdown', at(b.x + 20, b.y + 10)));
+            svg.dispatchEvent(new PointerEvent('pointermove', at(b.x + 260, b.y + 10)));
+            svg.dispatchEvent(new PointerEvent('pointerup', at(b.x + 260, b.y + 10)));""")
+        moved = block_xy(2)
+        js(driver, "window.rcb4Studio.editor.sel = 2")
+        js(driver, """const n = document.querySelector('#ed-step-name');
+                      n.value = 'reach'; n.dispatchEvent(new Event('change'));""")
+        saved = driver.execute_async_script(
+            "window.rcb4Studio.request({op: 'motion_check', text: window.rcb4Studio.editor.text()})"
+            ".then((r) => arguments[0](r.yaml), (e) => arguments[0]('ERROR ' + e.message))") or ""
+        check('name: "reach"' in saved and re.search(r"\n    at: \[\d+, \d+\]", saved),
+              f"the saved motion file keeps the pose's name and its block's place ({saved[:400]!r})")
+        laid_out = os.path.join(poses, "laid-out.yaml")
+        with open(laid_out, "w") as f:
+            f.write(saved)
+        js(driver, "window.savedConfirm = window.confirm; window.confirm = () => true")
+        click(driver, "ed-new")
+        js(driver, "document.querySelector('#ed-file').hidden = false")
+        driver.find_element("id", "ed-file").send_keys(laid_out)
+        check(wait_until(lambda: "laid-out.yaml: opened" in message(driver), timeout=10), f"opened again ({message(driver)!r})")
+        js(driver, "window.confirm = window.savedConfirm; document.querySelector('#ed-file').hidden = true")
+        again = block_xy(2)
+        js(driver, "window.rcb4Studio.editor.sel = 2")
+        listed = js(driver, "return [...document.querySelectorAll('li.step')].map((x) => x.textContent).join(' | ')")
+        on_timeline = js(driver, "return [...document.querySelectorAll('#ed-timeline .block')].map((b) => b.textContent)")
+        check(abs(again[0] - moved[0]) < 2 and abs(again[1] - moved[1]) < 2 and "reach" in listed
+              and "reach" in on_timeline,
+              f"opened, the block is where it was dragged and the pose is named in the list and on the timeline "
+              f"({moved} -> {again}, {listed!r}, {on_timeline})")
+
         # Layout: at three common screen sizes the robot and the pose being edited are seen
         # together (the robot's panel stays under the header while the editor scrolls).
         js(driver, "window.rcb4Studio.editor.sel = 2")
@@ -307,8 +343,8 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         n_steps = len(js(driver, "return window.rcb4Studio.editor.doc.steps"))
         js(driver, "document.querySelector('#poses li[data-pose=crouch] button.insert').click()")
         got = wait_until(lambda: js(driver, "const s = window.rcb4Studio.editor.doc.steps; return s.length > arguments[0] && s[1]", n_steps))
-        check(got == {"pose": {"left_knee": 60, "right_knee": -60}, "time_ms": 800},
-              f"Insert: the saved pose crouch becomes step 2 with its time ({got}, {message(driver)!r})")
+        check(got == {"pose": {"left_knee": 60, "right_knee": -60}, "time_ms": 800, "name": "crouch"},
+              f"Insert: the saved pose crouch becomes step 2 with its time and its name ({got}, {message(driver)!r})")
         js(driver, "document.querySelector('#poses li[data-pose=broken] button.insert').click()")
         check(wait_until(lambda: "beyond its limits" in message(driver), timeout=5)
               and len(js(driver, "return window.rcb4Studio.editor.doc.steps")) == n_steps + 1,

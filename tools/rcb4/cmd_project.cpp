@@ -227,15 +227,33 @@ struct flow_options {
   bool force = false;
 };
 
-/** FILE.xml compiled into slot @p n of @p layout, as bytes (and what was adjusted). */
-std::pair<std::vector<std::uint8_t>, std::vector<std::string>> compile(const std::string& file,
-                                                                       const rcb4::rom_layout& layout, unsigned n) {
+/** A flowchart compiled: its bytes, what was adjusted, and how its blocks are shown (by the address they start at). */
+struct compiled {
+  std::vector<std::uint8_t> bytes;
+  std::vector<std::string> notes;
+  std::vector<std::pair<std::uint32_t, ro::step_view>> views;
+};
+
+/** FILE.xml compiled into slot @p n of @p layout. */
+compiled compile(const std::string& file, const rcb4::rom_layout& layout, unsigned n) {
   try {
-    const auto c =
-        h4::compile_flowchart(h4::load_flowchart(file), sv::slot_for(layout, n).address.value(), layout, file);
-    std::vector<std::uint8_t> bytes;
-    for (const auto& f : c.frames) bytes.insert(bytes.end(), f.begin(), f.end());
-    return {bytes, c.notes};
+    const auto f = h4::load_flowchart(file);
+    const auto c = h4::compile_flowchart(f, sv::slot_for(layout, n).address.value(), layout, file);
+    compiled out;
+    for (const auto& frame : c.frames) out.bytes.insert(out.bytes.end(), frame.begin(), frame.end());
+    out.notes = c.notes;
+    // A block's place on HTH4's canvas (negative coordinates moved in) and its label, else its name.
+    long left = 0, top = 0;
+    for (const auto& b : f.blocks)
+      if (b.at) left = std::min(left, (*b.at)[0]), top = std::min(top, (*b.at)[1]);
+    for (const auto& [address, b] : c.placed) {
+      const auto& blk = f.blocks[b];
+      ro::step_view v;
+      v.name = (blk.text.empty() ? blk.name : blk.text).substr(0, 80);
+      if (blk.at) v.at = std::array<long, 2>{(*blk.at)[0] - left, (*blk.at)[1] - top};
+      out.views.emplace_back(address, std::move(v));
+    }
+    return out;
   } catch (const rcb4::robot::profile_error& e) {
     throw usage_error(e.what());
   }
@@ -251,9 +269,12 @@ int flow_to_file(const flow_options& o, const globals& g) {
   const auto* named = named_layout(o.m);
   const auto& layout = named ? *named : rcb4::hth4_2_2;
   const auto n = static_cast<unsigned>(o.slot);
-  const auto [bytes, notes] = compile(o.file, layout, n);
+  const auto c = compile(o.file, layout, n);
+  const auto& bytes = c.bytes;
+  const auto& notes = c.notes;
   const auto where = sv::slot_for(layout, n);
-  const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where));
+  std::vector<std::uint32_t> starts;
+  const auto p = rcb4::motion::lift(rcb4::motion::disassemble(bytes, where), &starts);
   if (!rcb4::motion::ok(p))
     throw failure(exit_usage,
                   fmt::format("{}: compiled, but a motion file cannot express it: {}", o.file,
@@ -262,6 +283,15 @@ int flow_to_file(const flow_options& o, const globals& g) {
   auto d = ro::from_program(std::get<rcb4::motion::program>(p), robot_of(g), layout,
                             static_cast<rcb4::output_period>((o.period_ms - 10) / 5));
   d.name = std::filesystem::path(o.file).stem().string();
+  // Each block's place and name on the step its code starts with (past a label there: the studio
+  // draws a label above the step it names); blocks without code share the next one's step.
+  d.views.resize(d.steps.size());
+  for (const auto& [address, view] : c.views)
+    for (std::size_t k = 0; k < starts.size() && k < d.steps.size(); ++k) {
+      if (starts[k] != address || std::holds_alternative<rcb4::motion::label>(d.steps[k])) continue;
+      if (d.views[k] == ro::step_view{}) d.views[k] = view;
+      break;
+    }
   try {
     ro::save_motion(o.out, d,
                     fmt::format("imported by rcb4 from the HTH4 flowchart {} (compiled for slot {}, {} layout)", o.file,
@@ -284,7 +314,9 @@ int flow_push(session& s, const flow_options& o, const globals& g) {
   const auto& layout = layout_for(s, o.m);
   const auto n = static_cast<unsigned>(o.push);
   sv::slot_for(layout, n);
-  const auto [bytes, notes] = compile(o.file, layout, n);
+  const auto c = compile(o.file, layout, n);
+  const auto& bytes = c.bytes;
+  const auto& notes = c.notes;
   session_link link(s, g.json);
   sv::push_source src;
   src.bin = bytes;

@@ -142,9 +142,10 @@ inline std::optional<compare> compare_of(const condition& c) {
 
 /**
  * The program of @p l where its code is contiguous from the slot's start and every instruction
- * belongs to a step; a failure names the first address that does not.
+ * belongs to a step; a failure names the first address that does not. With @p starts, the ROM
+ * address of each step's first frame (a label's: the frame after it) is put there, a step each.
  */
-inline outcome<program> lift(const listing& l) {
+inline outcome<program> lift(const listing& l, std::vector<std::uint32_t>* starts = nullptr) {
   if (!l.problems.empty()) return failure{l.problems.front()};
   const std::uint32_t base = l.where.address.value();
   std::set<std::uint32_t> targets;
@@ -203,6 +204,8 @@ inline outcome<program> lift(const listing& l) {
     } else {
       return cannot("a command motions do not use");
     }
+    if (starts)
+      while (starts->size() < p.steps.size()) starts->push_back(in.address);
   }
   return p;
 }

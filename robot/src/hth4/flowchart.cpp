@@ -40,6 +40,10 @@ flow_block read_block(const xml_in& x, const pugi::xml_node& a, bool old_schema,
   b.name = x.text(a, "Name");
   b.guid = x.text(a, "GUID");
   b.base_name = x.text(a, "BaseName");
+  if (const auto t = a.child("Text")) b.text = t.child_value();
+  if (const auto l = a.child("Location"))
+    b.at = std::array<long, 2>{static_cast<long>(x.integer(l, "X", -100000, 100000)),
+                               static_cast<long>(x.integer(l, "Y", -100000, 100000))};
   const auto flag = x.text(a, "MotionFlag");
   if (flag != "Start" && flag != "None") x.fail(a.child("MotionFlag"), "'" + flag + "' is not Start or None");
   b.start = flag == "Start";
@@ -258,6 +262,8 @@ compiled_flowchart compile_flowchart(const flowchart& f, std::uint32_t address, 
       jump_to(*placed[t]);
   }
   emit({0x03, 0x0D, 0x10, 0xFF});
+  for (std::size_t b = 0; b < placed.size(); ++b)
+    if (placed[b]) out.placed.push_back({*placed[b], b});
   for (const auto& [frame, target] : fixups) set_branch_target(out.frames[frame], *placed[target]);  // step 4
   if (at - address > layout.slot_size)
     fail(nullptr, "compiles to " + std::to_string(at - address) + " bytes, more than a " +

@@ -271,3 +271,65 @@ TEST_CASE("motion file: written to a .yaml file and read back", "[motion_file]")
   CHECK_THROWS_AS(save_motion(dir / "no" / "such" / "w.yaml", d), profile_error);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("motion file: a step's name and flowchart place are kept, and the board never sees them", "[motion_file]") {
+  const std::string text =
+      "robot: KHR-3HV\n"
+      "period_ms: 15\n"
+      "steps:\n"
+      "  - set_counter: 3\n"
+      "    at: [8, 16]\n"
+      "  - label: again\n"
+      "  - pose: {left_knee: 30}\n"
+      "    time_ms: 300\n"
+      "    name: \"knee up\"\n"
+      "    at: [8, 96]\n"
+      "  - loop: again\n"
+      "    name: twice more\n"
+      "  - end\n";
+  const auto d = parse_motion(text, "v.yaml", khr());
+  REQUIRE(d.views.size() == 5);
+  CHECK(d.views[0].at == std::array<long, 2>{8, 16});
+  CHECK(d.views[0].name.empty());
+  CHECK(d.views[1] == step_view{});
+  CHECK(d.views[2].name == "knee up");
+  CHECK(d.views[2].at == std::array<long, 2>{8, 96});
+  CHECK(d.views[3].name == "twice more");
+  CHECK_FALSE(d.views[3].at);
+  // The same bytes as the file without them.
+  std::string stripped;
+  for (std::size_t at = 0; at < text.size();) {
+    const auto nl = text.find('\n', at);
+    const auto line = text.substr(at, nl - at + 1);
+    if (line.find("name:") == std::string::npos && line.find("at:") == std::string::npos) stripped += line;
+    at = nl + 1;
+  }
+  const auto plain = parse_motion(stripped, "p.yaml", khr());
+  CHECK(bytes_of(d) == bytes_of(plain));
+  // Written and read again: the same views; JSON carries them too.
+  const auto yaml = motion_yaml(d);
+  CHECK(yaml.find("    name: \"knee up\"\n    at: [8, 96]\n") != std::string::npos);
+  CHECK(parse_motion(yaml, "again.yaml", khr()).views == d.views);
+  CHECK(motion_json(d).find("\"at\":[8,96]") != std::string::npos);
+  // A file without any keeps none.
+  CHECK(plain.views.empty());
+}
+
+TEST_CASE("motion file: a bad name or place is refused with its line", "[motion_file]") {
+  const auto bad = [](const std::string& step, const std::string& want) {
+    const std::string text =
+        "period_ms: 15\nsteps:\n  - pose: {left_knee: 30}\n    time_ms: 300\n" + step + "  - end\n";
+    try {
+      (void)parse_motion(text, "b.yaml", khr());
+      FAIL("accepted: " << step);
+    } catch (const profile_error& e) {
+      CHECK_THAT(e.what(), Catch::Matchers::Contains(want));
+      CHECK_THAT(e.what(), Catch::Matchers::Contains("b.yaml:"));
+    }
+  };
+  bad("  - goto: x\n    at: [1]\n", "at: the flowchart block's place");
+  bad("  - goto: x\n    at: [1, -5]\n", "at: y");
+  bad("  - goto: x\n    at: {x: 1, y: 2}\n", "at: the flowchart block's place");
+  bad("  - goto: x\n    name: \"" + std::string(81, 'n') + "\"\n", "name: at most 80 characters");
+  bad("  - name: lonely\n", "the step says what it does");
+}

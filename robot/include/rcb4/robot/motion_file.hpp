@@ -30,6 +30,10 @@
 //     - label: done
 //     - end                         # RETURN
 //
+// Any step but end may also carry how the studio shows it, which the board never sees:
+//       name: crouch                # a name for the step (a pose's, in the list and timeline)
+//       at: [240, 96]               # its flowchart block's top-left, in pixels
+//
 // Every step is one step of the program (the same numbers in messages). A pose's angles are
 // checked against the joint's limits, its time against the 255 frames a CONST carries, and the
 // file's period against the board's, before anything is assembled.
@@ -39,6 +43,7 @@
 #include <rcb4/robot/model.hpp>
 #include <rcb4/robot/profile.hpp>
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -80,6 +85,13 @@ struct motion_call {
 using motion_step = std::variant<motion::label, motion_pose, motion::set_counter, motion::count_down, motion::branch_if,
                                  motion::go_to, motion_call, motion_params, motion::end>;
 
+/** How the studio shows a step (the board never sees it): its name and its flowchart block's place. */
+struct step_view {
+  std::string name;                       ///< a name for the step; empty: none
+  std::optional<std::array<long, 2>> at;  ///< the flowchart block's top-left (x, y) in pixels; none: laid out in order
+  friend bool operator==(const step_view&, const step_view&) = default;
+};
+
 /** A motion file. */
 struct motion_document {
   std::string robot;                           ///< the profile's robot name
@@ -87,6 +99,7 @@ struct motion_document {
   output_period period = output_period::ms15;  ///< the period the times were made for
   std::vector<motion_step> steps;              ///< in the order they are laid out
   std::vector<std::string> where;              ///< per step, "FILE:LINE" for messages (empty for steps made in code)
+  std::vector<step_view> views;                ///< per step, how the studio shows it (may be empty: none for any)
 };
 
 /**

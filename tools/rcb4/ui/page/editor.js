@@ -6,7 +6,7 @@
 
 import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
 import { stepForm } from './stepforms.js';
-import { createFlowchart, flowMove, flowShift } from './flowchart.js';
+import { createFlowchart, flowMove, flowShift, fromFile, toFile } from './flowchart.js';
 import { el, $, numberIn } from './dom.js';
 import { KINDS, at, describe, kindOf, segments } from './steps.js';
 
@@ -286,7 +286,7 @@ export function createEditor(root, ctx) {
     const poses = ed.doc.steps.map((s, i) => [s, i]).filter(([s]) => kindOf(s) === 'pose');
     const total = poses.reduce((a, [s]) => a + s.time_ms, 0) || 1;
     timeline.replaceChildren(cursor, ...poses.map(([s, i]) => {
-      const b = el('div', { class: 'block' + (i === ed.sel ? ' selected' : ''), title: `step ${i + 1}: ${s.time_ms} ms`, text: String(i + 1) });
+      const b = el('div', { class: 'block' + (i === ed.sel ? ' selected' : ''), title: `step ${i + 1}${s.name ? ` (${s.name})` : ''}: ${s.time_ms} ms`, text: s.name || String(i + 1) });
       b.style.flexGrow = String(Math.max(s.time_ms, 1) / total);
       b.addEventListener('click', () => { ed.sel = i; render(); });
       return b;
@@ -336,7 +336,7 @@ export function createEditor(root, ctx) {
         const r = form.read();
         if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}` + (r.why.endsWith('nothing changed') ? '' : ': nothing changed'), 'error');
         change(() => {
-          ed.doc.steps[ed.sel] = r.step;
+          ed.doc.steps[ed.sel] = s?.name && r.step && typeof r.step === 'object' ? { ...r.step, name: s.name } : r.step;
           if (r.renamed) {  // a renamed label: the jumps to it follow
             const [from, to] = r.renamed;
             for (const x of ed.doc.steps)
@@ -431,7 +431,10 @@ export function createEditor(root, ctx) {
       bt('ed-r2l', 'Right → left', 'the right limbs\' angles onto the left ones' + noBody, () => reshape((p) => mirrorPose(h, p, 'right'))),
       bt('ed-home', 'Home', 'every joint of this pose at 0° (the robot\'s home, with its trims)', home));
     for (const id of ['ed-mirror', 'ed-l2r', 'ed-r2l']) tools.querySelector(`#${id}`).disabled = !mirrorable;
-    detail.replaceChildren(el('div', { class: 'row small' }, `step ${ed.sel + 1}: pose over`, time, 'ms',
+    // Its name, shown in the list and on the timeline (kept in the motion file; the board never sees it).
+    const named = el('input', { id: 'ed-step-name', type: 'text', maxlength: 80, value: s.name || '', placeholder: 'name', 'aria-label': 'name of the pose' });
+    named.addEventListener('change', () => change(() => { const v = named.value.trim().slice(0, 80); if (v) s.name = v; else delete s.name; }));
+    detail.replaceChildren(el('div', { class: 'row small' }, `step ${ed.sel + 1}:`, named, 'pose over', time, 'ms',
       el('label', { class: 'small' }, live, ' live on the robot')), tools, el('div', { class: 'pose-joints' }, ...rows));
     ctx.controls();
   }
@@ -440,13 +443,14 @@ export function createEditor(root, ctx) {
   function sendLive(joints) { if (ctx.controlling()) ctx.send({ op: 'move', joints }); }
 
   // --- files and slots ---
-  // The motion file: the steps, not where the flowchart draws them (doc.flow stays in the editor).
-  const text = () => JSON.stringify({ ...ed.doc, flow: undefined, name: name.value.trim() || undefined, robot: h.robot });
+  // The motion file: the steps, each with its flowchart block's place (`at`) and its name.
+  const text = () => JSON.stringify({ ...ed.doc, steps: toFile(ed.doc), flow: undefined, name: name.value.trim() || undefined, robot: h.robot });
   name.addEventListener('change', () => change(() => { ed.doc.name = name.value.trim(); }));
   function load(doc) {
     ed.undo.push(snapshot());
     ed.redo = [];  // what was undone before belongs to the motion replaced
-    ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: doc.steps?.length ? doc.steps : ['end'] };
+    const opened = fromFile(doc.steps?.length ? doc.steps : ['end']);
+    ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: opened.steps, flow: opened.flow };
     ed.sel = 0;
     render();
   }
@@ -588,6 +592,8 @@ export function createEditor(root, ctx) {
   return {
     load, render,
     get doc() { return ed.doc; },
+    /** The motion as the page saves and pushes it: the file's JSON text (tests). */
+    text,
     /** The selected step's index; setting it selects that step (tests). */
     get sel() { return ed.sel; },
     set sel(i) { ed.sel = i; render(); },
@@ -595,7 +601,7 @@ export function createEditor(root, ctx) {
     insertPose(joints, timeMs, poseName) {
       const period = ed.doc.period_ms || 10;
       const ok = Number.isInteger(timeMs) && timeMs >= period && timeMs <= 255 * period;
-      insert({ pose: { ...joints }, time_ms: ok ? timeMs : 500 });
+      insert({ pose: { ...joints }, time_ms: ok ? timeMs : 500, ...(poseName ? { name: String(poseName).slice(0, 80) } : {}) });
       const own = ok || timeMs === null || timeMs === undefined ? '' : ` over 500 ms (its own ${timeMs} ms is no pose time here)`;
       ctx.say(`pose ${poseName} inserted as step ${ed.sel + 1}${own}`);
     },

@@ -5,8 +5,9 @@
 // to connect it there (a label is put before that block when it has none). What does not connect
 // is marked as you build: a jump to no label, a label nothing jumps to, a loop with no counter set
 // before it (or one set again inside it), a motion that runs off its end. A click selects the step (its form below).
-// Positions are kept with the motion in the editor (doc.flow, one per step; undo covers moves),
-// not in the motion file, which holds steps only.
+// Positions are kept with the motion in the editor (doc.flow, one per step; undo covers moves)
+// and in the motion file as each step's `at: [x, y]` (fromFile / toFile), so a motion saved,
+// pushed and opened again, or imported from an HTH4 flowchart, keeps its layout.
 // SPDX-License-Identifier: BSL-1.0
 
 const NS = 'http://www.w3.org/2000/svg';
@@ -23,10 +24,39 @@ const svg = (tag, attrs = {}, text) => {
 /** The key of step @p s that names its jump's label, or null. */
 export function jumpKey(kind) { return JUMPS[kind] ?? null; }
 
-/** Where step @p i's block is: its kept position, else in a column in the list's order. */
+const placed = (p) => p && Number.isFinite(p.x) && Number.isFinite(p.y);
+
+/**
+ * Where step @p i's block is: its kept position; a label without one above the step it names
+ * when that step has one (an imported flowchart places blocks, not their labels); else in a
+ * column in the list's order.
+ */
 export function positionOf(doc, i) {
   const p = doc.flow?.[i];
-  return p && Number.isFinite(p.x) && Number.isFinite(p.y) ? p : { x: X0, y: Y0 + i * (H + GAP) };
+  if (placed(p)) return p;
+  const s = doc.steps?.[i], next = doc.flow?.[i + 1];
+  if (s && typeof s === 'object' && 'label' in s && placed(next)) return { x: next.x, y: Math.max(0, next.y - H - 6) };
+  return { x: X0, y: Y0 + i * (H + GAP) };
+}
+
+/** The steps of a motion file → { steps, flow }: each step's `at` becomes its block's place. */
+export function fromFile(steps) {
+  const flow = steps.map((s) => (s && typeof s === 'object' && Array.isArray(s.at) ? { x: Number(s.at[0]), y: Number(s.at[1]) } : null));
+  const clean = steps.map((s) => {
+    if (!s || typeof s !== 'object' || !('at' in s)) return s;
+    const { at, ...rest } = s;  // eslint-disable-line no-unused-vars
+    return rest;
+  });
+  return { steps: clean, flow: flow.some(placed) ? flow : undefined };
+}
+
+/** The editor's steps as the motion file keeps them: each with its block's place (end, a bare word, has none). */
+export function toFile(doc) {
+  return doc.steps.map((s, i) => {
+    const p = doc.flow?.[i];
+    if (!placed(p) || !s || typeof s !== 'object') return s;
+    return { ...s, at: [Math.min(100000, Math.max(0, Math.round(p.x))), Math.min(100000, Math.max(0, Math.round(p.y)))] };
+  });
 }
 
 /** Keeps doc.flow in step with the steps: call after inserting at @p at (n = 1) or removing (n = -1). */

@@ -28,8 +28,13 @@ export function kindOf(s) {
   return '?';
 }
 
-/** One line for step @p s. */
+/** One line for step @p s, after its name when it has one. */
 export function describe(s) {
+  const d = describeKind(s);
+  return s && typeof s === 'object' && s.name ? `${s.name}: ${d}` : d;
+}
+
+function describeKind(s) {
   const k = kindOf(s);
   if (k === 'pose') return `pose: ${Object.keys(s.pose).length} joints, ${s.time_ms} ms`;
   if (k === 'end') return 'end';
@@ -41,7 +46,8 @@ export function describe(s) {
   if (k === 'if_ram') return `if RAM ${s.if_ram} … go to ${s.goto}`;
   if (k === 'goto') return `go to ${s.goto}`;
   if (k === 'call') return `call motion ${s.call}`;
-  return JSON.stringify(s);
+  const { name, ...rest } = s;  // eslint-disable-line no-unused-vars
+  return JSON.stringify(rest);
 }
 
 /**

@@ -22,8 +22,10 @@
 #include <rcb4/memory_map.hpp>
 #include <rcb4/robot/hth4/project.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -35,6 +37,8 @@ struct flow_block {
   std::string name;                             ///< not unique
   std::string guid;                             ///< its identity
   std::string base_name;                        ///< the block type (Pos, Loop, CmpButton, Wait, MotionJump, ...: §5.5)
+  std::string text;                             ///< Text: the label the user gave it (absent in some old files)
+  std::optional<std::array<long, 2>> at;        ///< Location{X,Y}: its place on HTH4's canvas (GUI only)
   bool start = false;                           ///< MotionFlag Start
   std::vector<std::vector<std::uint8_t>> code;  ///< ProgramCode frames, each SIZE and SUM checked
   unsigned line = 0;                            ///< where it is in its file, for messages
@@ -64,6 +68,8 @@ flowchart load_flowchart(const std::filesystem::path& path);
 struct compiled_flowchart {
   std::vector<std::vector<std::uint8_t>> frames;  ///< the frames as HTH4 lays them out, ending in 03 0D 10 FF
   std::vector<std::string> notes;                 ///< what was adjusted (a callee moved to @p layout)
+  std::vector<std::pair<std::uint32_t, std::size_t>>
+      placed;  ///< (ROM address of its first frame, block) of each block laid out
 };
 
 /**
