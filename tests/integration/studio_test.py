@@ -255,6 +255,17 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         said = wait_until(lambda: "played" in message(driver) and message(driver), timeout=15)
         check(said and abs((measured(driver, "left_knee") or 0) - 10) < 1 and abs((measured(driver, "head_yaw") or 0) - 15) < 1,
               f"Play on robot ends at the last pose ({said!r}, knee {measured(driver, 'left_knee')})")
+        # Play from here: from the selected pose on (its pose reached first), the poses before it not played.
+        slide(driver, "left_knee", -20)
+        wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 20) < 0.6, timeout=10)
+        poses_at = js(driver, "return window.rcb4Studio.editor.doc.steps.map((s, i) => s && s.pose ? i : -1).filter((i) => i >= 0)")
+        js(driver, "window.rcb4Studio.editor.sel = arguments[0]", poses_at[-2])
+        js(driver, "document.querySelector('#message').textContent = ''")
+        click(driver, "id", "ed-play-here")
+        said = wait_until(lambda: "played" in message(driver) and message(driver), timeout=15)
+        check(said and "played 2 poses" in said and abs((measured(driver, "left_knee") or 0) - 10) < 1,
+              f"Play from here plays the last two of {len(poses_at)} poses and ends at the last ({said!r}, "
+              f"knee {measured(driver, 'left_knee')})")
         # Stop while the robot is still on its way into the first pose: it holds there and the
         # motion is not played after all (nothing the user did not ask for).
         slide(driver, "left_knee", -40)

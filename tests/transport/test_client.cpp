@@ -383,13 +383,17 @@ TEST_CASE("client: faults on the line never turn into wrong data, and the line r
     switch (timing.load()) {
       case 1: return {{0us, 1}, {3ms, 2}, {3ms, size}};                          // split in three, in time
       case 2: return std::vector<t::reply_piece>(size, t::reply_piece{1ms, 1});  // byte by byte
-      case 3: return {{60ms, size}};                                             // after the deadline
-      case 4: return {{0us, size / 2}, {60ms, size}};                            // half, then late
+      case 3: return {{250ms, size}};                                            // after the deadline
+      case 4: return {{0us, size / 2}, {250ms, size}};                           // half, then late
       default: return {};
     }
   };
   served_board late(so2);
-  auto c2 = open_client(io, late.server->where(), opt);
+  // A deadline of 60 ms beyond the wire time: the pieces in time (6 ms of pauses) arrive well
+  // within it on a loaded machine, the late ones (250 ms) well after it.
+  auto opt2 = opt;
+  opt2.turnaround = 60ms;
+  auto c2 = open_client(io, late.server->where(), opt2);
   const auto config = move::read_ram(ram::config, 2).value();
   for (int m : {1, 2}) {
     INFO("timing mode " << m);

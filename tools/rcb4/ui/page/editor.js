@@ -89,7 +89,8 @@ export function createEditor(root, ctx) {
       bt('ed-push', 'Push', 'write the motion into the slot (its old bytes are backed up first)', push, 'needs-control'),
       bt('ed-preview', 'Preview', 'play it in 3D, at its timing, without the robot', () => preview(false)),
       bt('ed-preview-here', 'From here', 'preview from the selected step (where the board first reaches it)', () => preview(true)),
-      bt('ed-play', 'Play on robot', 'play it from the host at its timing (the first pose is reached at the speed limit)', play, 'needs-control'),
+      bt('ed-play', 'Play on robot', 'play it from the host at its timing (the first pose is reached at the speed limit)', () => play(false), 'needs-control'),
+      bt('ed-play-here', 'Play from here', 'play it on the robot from the selected step (its pose reached at the speed limit; the steps before it are not played)', () => play(true), 'needs-control'),
       bt('ed-stop', 'Stop', 'stop the preview and a play on the robot', stop)),
     el('div', { class: 'row' }, kind,
       bt('ed-add', 'Add', 'add a step of that kind after the selected one (a pose: the ghost\'s)', () => add(kind.value)),
@@ -550,17 +551,43 @@ export function createEditor(root, ctx) {
     };
     ed.preview = requestAnimationFrame(tick);
   }
-  async function play() {
+  /**
+   * The steps played from step @p k: the counters the steps before it set (their last values, so
+   * a loop from there on goes round as often as from the top, not 255 times from whatever RAM
+   * holds), then a jump to a label put before step k; every step kept, so the loops and branches
+   * from there find their labels, and the steps before k run only when something jumps back.
+   */
+  function fromStep(list, k) {
+    if (k <= 0) return list;
+    const names = new Set(list.filter((s) => kindOf(s) === 'label').map((s) => s.label));
+    let label = 'from_here';
+    for (let n = 2; names.has(label); n += 1) label = `from_here_${n}`;
+    const counters = new Map();
+    for (const s of list.slice(0, k)) if (kindOf(s) === 'set_counter') counters.set(s.counter ?? 'C1', s);
+    return [...counters.values(), { goto: label }, ...list.slice(0, k), { label }, ...list.slice(k)];
+  }
+  /** Plays the motion on the robot from the host; @p fromSel: from the selected step. */
+  async function play(fromSel = false) {
     stop();
     // A Stop pressed while the robot moves into the first pose holds it there and ends this play:
     // nothing more is sent once the run it started is no longer the current one.
     const run = ++ed.run;
     ed.playing = true;
-    const first = ed.doc.steps.find((s) => kindOf(s) === 'pose');
+    const played = fromSel ? fromStep(ed.doc.steps, ed.sel) : ed.doc.steps;
+    const motion = fromSel ? JSON.stringify({ ...JSON.parse(text()), steps: played }) : text();
+    let first;  // the first pose the board plays (no button held, RAM 0: as a preview assumes)
+    try {
+      const segs = segments(played, ctx.measured());
+      first = segs.length ? played[segs[0].step] : null;
+    } catch (e) { first = null; }
+    if (fromSel && !first) {
+      ed.playing = false;
+      return ctx.say(`not played: no pose is played from step ${ed.sel + 1} on (nothing moved)`, 'error');
+    }
     try {
       // The whole motion is checked before the robot moves into its first pose: a motion that
       // will be refused moves nothing (the server checks it again when it plays it).
-      const checked = await ctx.request({ op: 'motion_check', text: text() });
+      const checked = await ctx.request({ op: 'motion_check', text: motion });
       if (run !== ed.run) return;
       if (checked.problem) {
         ed.playing = false;
@@ -571,8 +598,8 @@ export function createEditor(root, ctx) {
         await new Promise((done) => setTimeout(done, (r.ms ?? 0) + 50));
         if (run !== ed.run) return;
       }
-      await ctx.request({ op: 'play_motion', text: text() });
-      if (run === ed.run) ctx.say('playing on the robot from the host');
+      await ctx.request({ op: 'play_motion', text: motion });
+      if (run === ed.run) ctx.say(fromSel ? `playing on the robot from the host, from step ${ed.sel + 1}` : 'playing on the robot from the host');
     } catch (e) {
       if (run !== ed.run) return;
       ed.playing = false;  // refused or failed: nothing of this play runs, nothing to stop
