@@ -8,7 +8,8 @@ import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
 import { stepForm } from './stepforms.js';
 import { createFlowchart, flowMove, flowShift, fromFile, toFile } from './flowchart.js';
 import { el, $, numberIn } from './dom.js';
-import { KINDS, at, describe, kindOf, segments } from './steps.js';
+import { KINDS, describe, kindOf, segments } from './steps.js';
+import { createPlayback } from './playback.js';
 
 /** The largest motion file the editor opens (the server's max_text_bytes, docs/browser.md). */
 const MAX_FILE_BYTES = 512 * 1024;
@@ -91,7 +92,7 @@ export function createEditor(root, ctx) {
       bt('ed-preview-here', 'From here', 'preview from the selected step (where the board first reaches it)', () => preview(true)),
       bt('ed-play', 'Play on robot', 'play it from the host at its timing (the first pose is reached at the speed limit)', () => play(false), 'needs-control'),
       bt('ed-play-here', 'Play from here', 'play it on the robot from the selected step (its pose reached at the speed limit; the steps before it are not played)', () => play(true), 'needs-control'),
-      bt('ed-stop', 'Stop', 'stop the preview and a play on the robot', stop)),
+      bt('ed-stop', 'Stop', 'stop the preview and a play on the robot', () => stop())),
     el('div', { class: 'row' }, kind,
       bt('ed-add', 'Add', 'add a step of that kind after the selected one (a pose: the ghost\'s)', () => add(kind.value)),
       bt('ed-capture', 'Capture', 'add the robot\'s measured pose (all joints, or the ticked ones of the selected pose)', capture),
@@ -521,98 +522,9 @@ export function createEditor(root, ctx) {
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
   }
 
-  // --- preview, play, stop ---
-  /** Plays the motion in 3D; @p fromSel: from the first time the board reaches the selected step. */
-  function preview(fromSel = false) {
-    stop();
-    let segs;
-    try { segs = segments(ed.doc.steps, ctx.measured()); } catch (e) { return ctx.say(`preview: ${e.message}`, 'error'); }
-    const total = segs.reduce((a, g) => a + g.ms, 0);
-    let skip = 0;
-    if (fromSel) {
-      const k = segs.findIndex((g) => g.step >= ed.sel);
-      if (k < 0) return ctx.say(`preview: no pose is played from step ${ed.sel + 1} on (no button held, RAM 0)`, 'error');
-      skip = segs.slice(0, k).reduce((a, g) => a + g.ms, 0);
-    }
-    const t0 = performance.now() - skip;
-    ed.previewFrom = skip;
-    cursor.hidden = false;
-    $('#ed-result').textContent = 'previewing…';
-    const tick = () => {
-      const t = performance.now() - t0;
-      ctx.view?.setGhost(at(segs, Math.min(t, total)));
-      cursor.style.left = `${Math.min(t / Math.max(total, 1), 1) * 100}%`;
-      if (t < total && ed.preview) ed.preview = requestAnimationFrame(tick);
-      else {
-        ed.preview = null;
-        cursor.hidden = true;
-        $('#ed-result').textContent = `preview: ${(total / 1000).toFixed(2)} s of motion, shown in ${(t / 1000).toFixed(2)} s`;
-      }
-    };
-    ed.preview = requestAnimationFrame(tick);
-  }
-  /**
-   * The steps played from step @p k: the counters the steps before it set (their last values, so
-   * a loop from there on goes round as often as from the top, not 255 times from whatever RAM
-   * holds), then a jump to a label put before step k; every step kept, so the loops and branches
-   * from there find their labels, and the steps before k run only when something jumps back.
-   */
-  function fromStep(list, k) {
-    if (k <= 0) return list;
-    const names = new Set(list.filter((s) => kindOf(s) === 'label').map((s) => s.label));
-    let label = 'from_here';
-    for (let n = 2; names.has(label); n += 1) label = `from_here_${n}`;
-    const counters = new Map();
-    for (const s of list.slice(0, k)) if (kindOf(s) === 'set_counter') counters.set(s.counter ?? 'C1', s);
-    return [...counters.values(), { goto: label }, ...list.slice(0, k), { label }, ...list.slice(k)];
-  }
-  /** Plays the motion on the robot from the host; @p fromSel: from the selected step. */
-  async function play(fromSel = false) {
-    stop();
-    // A Stop pressed while the robot moves into the first pose holds it there and ends this play:
-    // nothing more is sent once the run it started is no longer the current one.
-    const run = ++ed.run;
-    ed.playing = true;
-    const played = fromSel ? fromStep(ed.doc.steps, ed.sel) : ed.doc.steps;
-    const motion = fromSel ? JSON.stringify({ ...JSON.parse(text()), steps: played }) : text();
-    let first;  // the first pose the board plays (no button held, RAM 0: as a preview assumes)
-    try {
-      const segs = segments(played, ctx.measured());
-      first = segs.length ? played[segs[0].step] : null;
-    } catch (e) { first = null; }
-    if (fromSel && !first) {
-      ed.playing = false;
-      return ctx.say(`not played: no pose is played from step ${ed.sel + 1} on (nothing moved)`, 'error');
-    }
-    try {
-      // The whole motion is checked before the robot moves into its first pose: a motion that
-      // will be refused moves nothing (the server checks it again when it plays it).
-      const checked = await ctx.request({ op: 'motion_check', text: motion });
-      if (run !== ed.run) return;
-      if (checked.problem) {
-        ed.playing = false;
-        return ctx.say(`not played: ${checked.problem} (nothing moved)`, 'error');
-      }
-      if (first) {  // into the first pose at the speed limit; from there, the authored timing
-        const r = await ctx.request({ op: 'move', joints: first.pose });
-        await new Promise((done) => setTimeout(done, (r.ms ?? 0) + 50));
-        if (run !== ed.run) return;
-      }
-      await ctx.request({ op: 'play_motion', text: motion });
-      if (run === ed.run) ctx.say(fromSel ? `playing on the robot from the host, from step ${ed.sel + 1}` : 'playing on the robot from the host');
-    } catch (e) {
-      if (run !== ed.run) return;
-      ed.playing = false;  // refused or failed: nothing of this play runs, nothing to stop
-      ctx.say(e.message, 'error');
-    }
-  }
-  function stop() {
-    ed.run += 1;
-    if (ed.preview) { cancelAnimationFrame(ed.preview); ed.preview = null; cursor.hidden = true; }
-    if (ed.playing && ctx.controlling()) ctx.send({ op: 'stop' });  // the play from the host, and a ROM motion it called
-    ed.playing = false;
-    ctx.view?.setGhost(poseAt(ed.sel));
-  }
+  // --- preview, play, stop: playback.js ---
+  const playback = createPlayback(ed, ctx, text, cursor, poseAt);
+  const { preview, play, stop } = playback;
   root.append(el('div', { id: 'ed-result', class: 'small muted' }));
 
   render();
