@@ -58,10 +58,10 @@ int main() {
     fmt::print("unexpected: {}\n", r.error);
     return EXIT_FAILURE;
   }
-  fmt::print("  {:<44}  {}\n  config {}\n", hex(config_reply), r.value, config_word::decode(r.value.u16()));
+  fmt::print("  {:<44}  {}\n  config {}\n", hex(config_reply), r.value(), config_word::decode(r.value().u16()));
   const std::uint8_t nack[] = {0x04, 0x00, 0x15, 0x19};
   auto n = parse_reply(nack, expected_reply(read_pos));
-  fmt::print("  {:<44}  {}\n", hex(nack), n.value);
+  fmt::print("  {:<44}  {}\n", hex(nack), n.value());
   const std::uint8_t corrupted[] = {0x05, 0x00, 0x8B, 0x40, 0xD1};
   auto bad = parse_reply(corrupted, expected_reply(read_config));
   fmt::print("  {:<44}  error: {}\n", hex(corrupted), bad.error);
@@ -71,5 +71,5 @@ int main() {
   fmt::print("  ICS 40:                  {}\n", ics_number::make(40).error());
   fmt::print("  AND into COM:            {}\n",
              logic::make(logic_op::and_, destination::com(), source::literal_u8(1)).error());
-  return bad.error == errc::bad_checksum && n.value.is_nack() ? EXIT_SUCCESS : EXIT_FAILURE;
+  return bad.error == errc::bad_checksum && n.value().is_nack() ? EXIT_SUCCESS : EXIT_FAILURE;
 }

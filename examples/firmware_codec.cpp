@@ -31,6 +31,6 @@ int main() {
   const auto n = serialize(cmd, tx).value();
   uart_write({tx.data(), n});
   const auto r = parse_reply(uart_read(), expected_reply(cmd));
-  std::printf("sent %zu bytes, board answered %s\n", n, r.ok() && r.value.is_ack() ? "ACK" : "something else");
-  return r.ok() && r.value.is_ack() ? 0 : 1;
+  std::printf("sent %zu bytes, board answered %s\n", n, r.ok() && r.value().is_ack() ? "ACK" : "something else");
+  return r.ok() && r.value().is_ack() ? 0 : 1;
 }

@@ -172,7 +172,7 @@ std::optional<rcb4::reply> exchange(Link& link, const rcb4::command& cmd, link_s
     const auto deadline = clock_type::now() + timeout;
     for (;;) {
       const auto p = rcb4::parse_reply(rx.first(have), shape);
-      if (p.ok()) return p.value;  // ACK, NACK or data: the operation decides what NACK means
+      if (p.ok()) return p.value();  // ACK, NACK or data: the operation decides what NACK means
       if (p.status == rcb4::parse_status::error) {
         const bool again = repeatable && attempt + 1 < 3;
         std::fprintf(stderr, "malformed reply (%s)%s\n", rcb4::message(p.error), again ? ", retrying" : "");

@@ -36,10 +36,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     check(r.consumed >= 1);
     if (r.status == rcb4::parse_status::complete) {
       const auto frame = in.first(r.consumed);
-      const auto again = rcb4::encode(r.value);
+      const auto again = rcb4::encode(r.value());
       check(again.size() == frame.size());
       check(std::equal(again.begin(), again.end(), frame.begin()));
-      check(rcb4::wire_size(r.value) == frame.size());
+      check(rcb4::wire_size(r.value()) == frame.size());
       for (std::size_t k = 0; k < frame.size(); ++k) {
         const auto p = rcb4::parse_command(frame.first(k), opt);
         check(p.status == rcb4::parse_status::need_more);

@@ -70,10 +70,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   check(frame.size() == shape.frame_size() || frame.size() == rcb4::ack_frame_size);
   check(frame[1] == shape.command);
   check(rcb4::checksum_ok(frame));
-  const auto again = rcb4::encode(r.value);
+  const auto again = rcb4::encode(r.value());
   check(again.size() == frame.size() && std::equal(again.begin(), again.end(), frame.begin()));
-  if (!shape.data) check(r.value.kind() != rcb4::reply_kind::data);
-  if (shape.data && r.value.kind() == rcb4::reply_kind::data) check(r.value.bytes().size() == shape.data_size);
+  if (!shape.data) check(r.value().kind() != rcb4::reply_kind::data);
+  if (shape.data && r.value().kind() == rcb4::reply_kind::data) check(r.value().bytes().size() == shape.data_size);
 
   // Split invariance: from every prefix, reading exactly what is asked gives the same reply.
   for (std::size_t cut = 0; cut < frame.size(); ++cut) {
@@ -84,7 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       check(have <= frame.size());
       p = rcb4::parse_reply(frame.first(have), shape);
     }
-    check(p.ok() && p.consumed == frame.size() && p.value == r.value);
+    check(p.ok() && p.consumed == frame.size() && p.value() == r.value());
   }
   const auto any = rcb4::parse_reply_frame(frame);
   check(any.ok() && any.consumed == frame.size());

@@ -25,8 +25,8 @@ namespace {
 std::optional<double> battery_volts_from(std::span<const std::uint8_t> line) {
   const auto read = rcb4::move::read_ram(rcb4::ram::ad(0).value(), 2).value();
   const auto r = rcb4::parse_reply(line, rcb4::expected_reply(rcb4::command{read}));
-  if (!r.ok() || r.value.kind() != rcb4::reply_kind::data) return std::nullopt;  // NACK, garbage, short
-  return rcb4::battery_volts(r.value.u16());
+  if (!r.ok() || r.value().kind() != rcb4::reply_kind::data) return std::nullopt;  // NACK, garbage, short
+  return rcb4::battery_volts(r.value().u16());
 }
 // --- end of your code ----------------------------------------------------------------------------
 

@@ -163,9 +163,8 @@ constexpr parse_result<command> parse_command(std::span<const std::uint8_t> in,
   if (!checksum_ok(frame)) return fail(errc::bad_checksum, size);
   auto c = detail::parse_alternative(frame, opt);
   if (!c) return fail(c.error(), size);
-  r.status = parse_status::complete;
-  r.value = *c;
   r.consumed = size;
+  r.complete(*c);
   return r;
 }
 

@@ -1,16 +1,16 @@
-// rcb4 — error codes of the codec, registered with <system_error>.
+// rcb4 — error codes of the codec and their messages. No <string>, no <system_error>: firmware and
+// single-header users pay for neither; std::error_code interop is in <rcb4/error_category.hpp>.
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
 #include <cstdint>
-#include <string>
-#include <system_error>
 
 namespace rcb4 {
 
 /**
  * Everything the codec can reject. Zero is "no error"; every other value has a message
- * (see message()). constexpr code uses the enum directly; std::error_code interop is below.
+ * (see message()). constexpr code uses the enum directly; std::error_code interop is in
+ * <rcb4/error_category.hpp>.
  */
 // A new code gets its line in result.hpp's detail::result_holds_error and bad_result_access()
 // too (-Wswitch names a code missing there), so that a constant expression names it.
@@ -130,25 +130,4 @@ constexpr const char* message(errc e) noexcept {
   return "unknown rcb4 error";
 }
 
-/** The std::error_category of rcb4::errc (the codec's); its name() is "rcb4". */
-class codec_category_impl final : public std::error_category {
- public:
-  /** The category name, "rcb4". */
-  const char* name() const noexcept override { return "rcb4"; }
-  /** The message of the errc value @p ev. */
-  std::string message(int ev) const override { return rcb4::message(static_cast<errc>(ev)); }
-};
-
-/** The single instance of the codec's error category. */
-inline const std::error_category& codec_category() noexcept {
-  static const codec_category_impl instance;
-  return instance;
-}
-
-/** Makes a std::error_code from @p e (found by ADL for `std::error_code ec = errc::...`). */
-inline std::error_code make_error_code(errc e) noexcept { return {static_cast<int>(e), codec_category()}; }
-
 }  // namespace rcb4
-
-template <>
-struct std::is_error_code_enum<rcb4::errc> : std::true_type {};

@@ -37,8 +37,8 @@ class reply {
     r.data_ = bytes;
     return r;
   }
-  /** An ACK to ping. */
-  constexpr reply() noexcept = default;
+  /** No default: a reply is an ACK, a NACK or data, always made by name or by a parser. */
+  reply() = delete;
 
   /** ACK, NACK or data. */
   constexpr reply_kind kind() const noexcept { return kind_; }
@@ -107,13 +107,12 @@ constexpr parse_result<reply> finish_reply(std::span<const std::uint8_t> frame, 
   }
   if (status_frame) {
     if (frame[2] == nack_code)
-      r.value = reply::nack(frame[1]);
+      r.complete(reply::nack(frame[1]));
     else if (frame[2] == ack_code && ack_allowed)
-      r.value = reply::ack(frame[1]);
-    else {
+      r.complete(reply::ack(frame[1]));
+    else
       r.error = frame[2] == ack_code ? errc::unexpected_ack : errc::bad_ack_code;
-      return r;
-    }
+    return r;
   } else {
     // A data frame carries 1-252 bytes (protocol.md §2.2): a 3-byte frame carries none and is
     // refused here, never trapped on (a parser on a serial line must not trap on any input).
@@ -122,9 +121,8 @@ constexpr parse_result<reply> finish_reply(std::span<const std::uint8_t> frame, 
       r.error = errc::frame_too_short;
       return r;
     }
-    r.value = d.value();
+    r.complete(d.value());
   }
-  r.status = parse_status::complete;
   return r;
 }
 }  // namespace detail

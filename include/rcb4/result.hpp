@@ -4,6 +4,7 @@
 
 #include <rcb4/error.hpp>
 
+#include <memory>
 #include <type_traits>
 #include <utility>
 
@@ -120,11 +121,13 @@ constexpr void bad_result_access(errc e) noexcept {
 /**
  * Either a T or an rcb4::errc. Like std::expected (C++23) but constexpr in C++20 and usable
  * with -fno-exceptions: value() on an error fails to compile in a constant expression and
- * traps at run time, so check has_value() (or use value_or()) first.
+ * traps at run time, so check has_value() (or use value_or()) first. T need not be
+ * default-constructible: a failed result holds no T at all (the error is the discriminant).
  */
 template <class T>
 class [[nodiscard]] result {
-  static_assert(std::is_default_constructible_v<T>, "result<T> needs a default-constructible T");
+  static_assert(!std::is_reference_v<T> && !std::is_same_v<std::remove_cv_t<T>, errc>,
+                "result<T> holds a value type other than errc");
 
  public:
   using value_type = T;
@@ -134,9 +137,50 @@ class [[nodiscard]] result {
   template <class... Args>
   constexpr explicit result(std::in_place_t, Args&&... args) noexcept : value_(std::forward<Args>(args)...) {}
   /** A failed result; @p e must not be errc{}. */
-  constexpr result(errc e) noexcept : error_(e) {  // NOLINT(google-explicit-constructor)
+  constexpr result(errc e) noexcept : none_(), error_(e) {  // NOLINT(google-explicit-constructor)
     if (e == errc{}) detail::bad_result_access();
   }
+
+  // Copies and moves: trivial where T's are (the codec's commands), else member-wise.
+  constexpr result(const result&) noexcept
+    requires std::is_trivially_copy_constructible_v<T>
+  = default;
+  constexpr result(const result& o) noexcept : none_(), error_(o.error_) {
+    if (has_value()) std::construct_at(&value_, o.value_);
+  }
+  constexpr result(result&&) noexcept
+    requires std::is_trivially_move_constructible_v<T>
+  = default;
+  constexpr result(result&& o) noexcept : none_(), error_(o.error_) {
+    if (has_value()) std::construct_at(&value_, std::move(o.value_));
+  }
+  constexpr result& operator=(const result&) noexcept
+    requires(std::is_trivially_copy_assignable_v<T> && std::is_trivially_copy_constructible_v<T> &&
+             std::is_trivially_destructible_v<T>)
+  = default;
+  constexpr result& operator=(const result& o) noexcept {
+    if (this == &o) return *this;
+    if (o.has_value()) assign_value(o.value_);
+    else assign_error(o.error_);
+    return *this;
+  }
+  constexpr result& operator=(result&&) noexcept
+    requires(std::is_trivially_move_assignable_v<T> && std::is_trivially_move_constructible_v<T> &&
+             std::is_trivially_destructible_v<T>)
+  = default;
+  constexpr result& operator=(result&& o) noexcept {
+    if (this == &o) return *this;
+    if (o.has_value()) assign_value(std::move(o.value_));
+    else assign_error(o.error_);
+    return *this;
+  }
+  constexpr ~result()
+    requires std::is_trivially_destructible_v<T>
+  = default;
+  constexpr ~result() {
+    if (has_value()) value_.~T();
+  }
+
   /** True when a value is held. */
   constexpr bool has_value() const noexcept { return error_ == errc{}; }
   /** Same as has_value(). */
@@ -157,7 +201,7 @@ class [[nodiscard]] result {
     return std::move(value_);
   }
   /** The value, or @p fallback on error. */
-  constexpr T value_or(T fallback) const noexcept { return has_value() ? value_ : fallback; }
+  constexpr T value_or(T fallback) const& noexcept { return has_value() ? value_ : std::move(fallback); }
   /** The error, errc{} when a value is held. */
   constexpr errc error() const noexcept { return error_; }
   /** Access to the value; must hold one. */
@@ -165,8 +209,58 @@ class [[nodiscard]] result {
   /** Access to the value's members; must hold one. */
   constexpr const T* operator->() const noexcept { return &value(); }
 
+  /**
+   * @p f(value) when a value is held (f returns a result of its own), else this error: chains steps
+   * that can each fail, as std::expected::and_then.
+   */
+  template <class F>
+  constexpr auto and_then(F&& f) const& noexcept {
+    using R = std::remove_cvref_t<decltype(std::declval<F>()(std::declval<const T&>()))>;
+    if (!has_value()) return R(error_);
+    return std::forward<F>(f)(value_);
+  }
+  /** @p f(value), as a result, when a value is held, else this error (std::expected::transform). */
+  template <class F>
+  constexpr auto transform(F&& f) const& noexcept {
+    using U = std::remove_cvref_t<decltype(std::declval<F>()(std::declval<const T&>()))>;
+    if constexpr (std::is_void_v<U>) {
+      if (has_value()) std::forward<F>(f)(value_);
+      return result<void>(error_);
+    } else {
+      if (!has_value()) return result<U>(error_);
+      return result<U>(std::forward<F>(f)(value_));
+    }
+  }
+  /** This result when a value is held, else @p f(error) (a result of T): recovery from a failure. */
+  template <class F>
+  constexpr result or_else(F&& f) const& noexcept {
+    if (has_value()) return *this;
+    return std::forward<F>(f)(error_);
+  }
+
  private:
-  T value_{};
+  template <class V>
+  constexpr void assign_value(V&& v) noexcept {
+    if (has_value()) {
+      value_ = std::forward<V>(v);
+    } else {
+      std::construct_at(&value_, std::forward<V>(v));
+      error_ = errc{};
+    }
+  }
+  constexpr void assign_error(errc e) noexcept {
+    if (has_value()) {
+      value_.~T();
+      std::construct_at(&none_);
+    }
+    error_ = e;
+  }
+
+  struct empty {};
+  union {
+    empty none_;  ///< active while an error is held
+    T value_;     ///< active while error_ == errc{}
+  };
   errc error_{};
 };
 

@@ -13,7 +13,9 @@
 #include <array>
 #include <bit>
 #include <cstdint>
+#include <cstddef>
 #include <initializer_list>
+#include <iterator>
 #include <span>
 
 namespace rcb4 {
@@ -67,6 +69,9 @@ class servo_mask {
   /** Iterates the selected ICS numbers in ascending order. */
   class iterator {
    public:
+    using value_type = ics_number;             ///< what *it gives
+    using difference_type = std::ptrdiff_t;    ///< for std::ranges (a forward range)
+    using iterator_category = std::forward_iterator_tag;  ///< for the standard algorithms
     constexpr iterator() noexcept = default;
     constexpr explicit iterator(std::uint64_t rest) noexcept : rest_(rest) {}
     constexpr ics_number operator*() const noexcept { return ics_number::make(std::countr_zero(rest_)).value(); }
@@ -171,6 +176,9 @@ class servo_set {
   /** Iterates entries in ascending ICS order. */
   class iterator {
    public:
+    using value_type = entry;                  ///< what *it gives (ICS number and value)
+    using difference_type = std::ptrdiff_t;    ///< for std::ranges (a forward range)
+    using iterator_category = std::forward_iterator_tag;  ///< for the standard algorithms
     constexpr iterator() noexcept = default;
     constexpr iterator(servo_mask::iterator m, const T* v) noexcept : m_(m), v_(v) {}
     constexpr entry operator*() const noexcept { return {*m_, *v_}; }

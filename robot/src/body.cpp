@@ -160,8 +160,19 @@ std::string to_urdf(const model& m, const urdf_options& o) {
   }
   out += fmt::format("<robot name=\"{}\">\n", robot_name_of(m));
   out += "  <material name=\"rcb4_body\"><color rgba=\"0.8 0.8 0.82 1\"/></material>\n";
+  const auto* dyn = m.dynamics();
   for (const auto& l : k->links) {
     out += fmt::format("  <link name=\"{}{}\">\n", xml(o.prefix), xml(l.name));
+    // The mass model's figures in URDF's units: kg, m, kg*m^2 (the profile's g, mm, kg*mm^2).
+    if (const auto* lm = dyn ? dyn->find(l.name) : nullptr) {
+      const auto& w = lm->whole;
+      const auto& i = w.inertia;
+      out += fmt::format(
+          "    <inertial><origin xyz=\"{}\" rpy=\"0 0 0\"/><mass value=\"{:g}\"/>"
+          "<inertia ixx=\"{:g}\" ixy=\"{:g}\" ixz=\"{:g}\" iyy=\"{:g}\" iyz=\"{:g}\" izz=\"{:g}\"/></inertial>\n",
+          metres(w.com), w.mass / 1000, i[0] * 1e-6, i[3] * 1e-6, i[4] * 1e-6, i[1] * 1e-6, i[5] * 1e-6,
+          i[2] * 1e-6);
+    }
     for (const auto& s : l.shapes)
       out += fmt::format(
           "    <visual><origin xyz=\"{}\" rpy=\"{}\"/><geometry>{}</geometry><material name=\"rcb4_body\"/></visual>\n"

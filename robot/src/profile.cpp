@@ -65,7 +65,7 @@ pose parse_pose(std::string_view text, const std::string& source, const model& m
 model parse_profile_nodes(std::string_view text, const std::string& source) {
   const YAML::Node root = parse_yaml(text, source);
   if (!root.IsMap()) throw profile_error(source, "a profile is a mapping with robot, joints, groups, motions");
-  check_keys(source, root, {"robot", "joints", "groups", "motions", "mimic", "kinematics"}, "profile");
+  check_keys(source, root, {"robot", "joints", "groups", "motions", "mimic", "kinematics", "dynamics"}, "profile");
   const std::string name = root["robot"] ? scalar(source, root["robot"], "robot") : std::string("robot");
   const YAML::Node js = root["joints"];
   if (!js || !js.IsMap() || js.size() == 0)
@@ -127,6 +127,11 @@ model parse_profile_nodes(std::string_view text, const std::string& source) {
   if (const YAML::Node k = root["kinematics"]) {
     if (const auto p = out.attach_body(parse_body(source, k, names)))  // parse_body has checked it: never
       throw profile_error(source, "kinematics: " + p->message);
+  }
+  if (const YAML::Node d = root["dynamics"]) {
+    if (!out.body()) fail(source, d, "dynamics: the mass model needs the body: give kinematics: too");
+    if (const auto p = out.attach_dynamics(parse_dynamics(source, d, *out.body())))  // checked: never
+      throw profile_error(source, "dynamics: " + *p);
   }
   return out;
 }

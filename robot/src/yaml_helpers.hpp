@@ -124,5 +124,7 @@ inline std::string hex(std::uint32_t v, int digits) {
 
 /** A profile's `kinematics:` node, checked against the profile's joints; a profile_error at the entry at fault. */
 kinematics parse_body(const std::string& source, const YAML::Node& n, const std::vector<std::string>& profile_joints);
+/** A profile's `dynamics:` read and checked against @p body (a profile_error with its place). */
+dynamics parse_dynamics(const std::string& source, const YAML::Node& n, const kinematics& body);
 
 }  // namespace rcb4::robot::detail

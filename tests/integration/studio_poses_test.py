@@ -4,7 +4,8 @@
 # with their signs right (KHR-3HV: head yaw negated, pitch, roll and yaw of the limbs kept, as
 # robot/mirror.hpp works out from the body); a limb copied onto the other; Home; a joint "as in the
 # pose before"; a pose copied in one tab and pasted in another tab's motion; undo after each; and
-# with "live on the robot" off, none of it moves the robot (read through the studio's share).
+# with "live on the robot" off, none of it moves the robot (read through the studio's share); a
+# pose whose centre of mass lies outside its feet marked as the motion is edited.
 # Usage: studio_poses_test.py RCB4 [SCREENSHOT_DIR]
 # SPDX-License-Identifier: BSL-1.0
 import json
@@ -349,6 +350,23 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: "beyond its limits" in message(driver), timeout=5)
               and len(js(driver, "return window.rcb4Studio.editor.doc.steps")) == n_steps + 1,
               f"a saved pose beyond a limit is not inserted, and says why ({message(driver)!r})")
+
+        # Does it stand? A pose with both hips pitched far is marked in the list and the timeline,
+        # and the line under the timeline names it (issue 43 item 5: the server's balance check).
+        js(driver, """window.rcb4Studio.editor.load({ robot: 'KHR-3HV', period_ms: 10, steps: [
+                        { pose: { left_hip_pitch: 0, right_hip_pitch: 0 }, time_ms: 300 },
+                        { pose: { left_hip_pitch: -80, right_hip_pitch: -80 }, time_ms: 800, name: 'too far' }, 'end'] })""")
+        verdict = wait_until(lambda: (lambda t: t if "off its feet" in t else None)(
+            js(driver, "return document.querySelector('#ed-balance').textContent")), timeout=10)
+        marks = js(driver, """return [...document.querySelectorAll('#ed-steps [data-step], #ed-timeline [data-step]')]
+                              .filter((e) => e.classList.contains('falls')).map((e) => e.parentElement.id + ':' + e.dataset.step)""")
+        check(verdict and "step 2" in verdict and sorted(marks) == ["ed-steps:1", "ed-timeline:1"],
+              f"the pose off its feet is marked in the list and the timeline and named ({verdict!r}, {marks})")
+        js(driver, "window.rcb4Studio.editor.load({ robot: 'KHR-3HV', period_ms: 10, steps: [{ pose: { head_yaw: 30 }, time_ms: 300 }, 'end'] })")
+        verdict = wait_until(lambda: (lambda t: t if "every pose stands" in t else None)(
+            js(driver, "return document.querySelector('#ed-balance').textContent")), timeout=10)
+        check(verdict and not js(driver, "return document.querySelectorAll('.falls').length"),
+              f"a motion that stands says so, nothing marked ({verdict!r})")
 
         # Nothing of it moved the robot: live was off.
         after = {n: j["degrees"] for n, j in joints_on(dev).items()}

@@ -24,7 +24,7 @@ extern "C" unsigned rcb4_firmware_ics_probe(const unsigned char* rx, unsigned rx
   const read_eeprom read(id);
   const auto got = parse_exchange(read, std::span<const std::uint8_t>(rx, rx_len));
   if (!got.ok()) return 0;
-  auto image = got.value;
+  auto image = got.value();
   if (!image.set(field::stretch, 40)) return 0;
   const auto f = write_eeprom(id, image).request();
   for (std::size_t i = 0; i < f.size; ++i) tx[i] = f.data[i];

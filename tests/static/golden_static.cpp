@@ -24,7 +24,7 @@ constexpr bool requests_encode() {
 constexpr bool requests_parse() {
   for (const auto& g : golden::requests) {
     auto r = parse_command(g.frame, g.options);
-    if (!r.ok() || r.consumed != g.frame.size() || !(r.value == g.value)) return false;
+    if (!r.ok() || r.consumed != g.frame.size() || !(r.value() == g.value)) return false;
   }
   return true;
 }
@@ -36,7 +36,7 @@ constexpr bool requests_wire_size() {
 constexpr bool replies_parse() {
   for (const auto& g : golden::replies) {
     auto r = parse_reply(g.frame, g.expected);
-    if (!r.ok() || r.consumed != g.frame.size() || !(r.value == g.value)) return false;
+    if (!r.ok() || r.consumed != g.frame.size() || !(r.value() == g.value)) return false;
   }
   return true;
 }
@@ -70,10 +70,10 @@ constexpr auto ics_id(unsigned n) { return ics::servo_id::make(n).value(); }
 static_assert(ics_same(ics::set_position::make(ics_id(3), 8833).value().request(), {0x83, 0x45, 0x01}));
 static_assert(ics_same(ics::read_parameter::make(ics_id(12), ics::sub::temperature).value().request(), {0xAC, 0x04}));
 static_assert(ics_same(ics::write_id(ics_id(9)).request(), {0xE9, 0x01, 0x01, 0x01}));
-static_assert(ics::parse_exchange(ics::read_id{}, std::array<std::uint8_t, 5>{0xFF, 0x00, 0x00, 0x00, 0xEC}).value ==
+static_assert(ics::parse_exchange(ics::read_id{}, std::array<std::uint8_t, 5>{0xFF, 0x00, 0x00, 0x00, 0xEC}).value() ==
               ics_id(12));
 static_assert(ics::parse_exchange(ics::set_position::make(ics_id(3), 8833).value(),
                                   std::array<std::uint8_t, 6>{0x83, 0x45, 0x01, 0x03, 0x3A, 0x4E})
-                  .value == 7502);
+                  .value() == 7502);
 static_assert(ics::position::counts(45.0).value() == 8833);
 }  // namespace

@@ -29,7 +29,7 @@ class board_wire {
     auto r = parse_reply(last_, shape);
     REQUIRE(r.ok());
     REQUIRE(r.consumed == last_.size());
-    return r.value;
+    return r.value();
   }
   /** Sends bytes and returns whatever the board answered (possibly nothing). */
   std::vector<std::uint8_t> send_bytes(std::span<const std::uint8_t> bytes, std::chrono::microseconds gap = {}) {

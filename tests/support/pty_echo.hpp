@@ -67,7 +67,7 @@ inline double raw_cycle_us(const std::string& path, ops::link_cost cost, const c
     ok = ok && raw_round_trip(fd, frame.bytes(), reply);
     const auto parsed = parse_reply(reply, shape);
     ok = ok && parsed.status == parse_status::complete;
-    return parsed.value;
+    return parsed.value();
   };
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < n && ok; ++i) {

@@ -1,5 +1,6 @@
 // Value types, servo sets (against a reference model), memory map, errors.
 // SPDX-License-Identifier: BSL-1.0
+#include <rcb4/error_category.hpp>
 #include <rcb4/fmt.hpp>
 
 #include <catch2/catch.hpp>

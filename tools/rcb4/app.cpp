@@ -243,8 +243,8 @@ std::string frame_printer::request(std::span<const std::uint8_t> frame) {
     return fmt::format("{:<30}  (not a request: {})", rcb4::hex(frame),
                        r.status == rcb4::parse_status::error ? rcb4::message(r.error) : "incomplete");
   }
-  expected_ = rcb4::expected_reply(r.value);
-  return fmt::format("{:<30}  {}", rcb4::hex(frame), r.value);
+  expected_ = rcb4::expected_reply(r.value());
+  return fmt::format("{:<30}  {}", rcb4::hex(frame), r.value());
 }
 
 std::vector<std::string> frame_printer::received(std::span<const std::uint8_t> bytes) {
@@ -256,7 +256,7 @@ std::vector<std::string> frame_printer::received(std::span<const std::uint8_t> b
     const std::size_t n = r.status == rcb4::parse_status::complete ? r.consumed : std::max<std::size_t>(r.consumed, 1);
     const auto frame = std::span<const std::uint8_t>(rx_).first(std::min(n, rx_.size()));
     if (r.status == rcb4::parse_status::complete)
-      lines.push_back(fmt::format("{:<30}  {}", rcb4::hex(frame), r.value));
+      lines.push_back(fmt::format("{:<30}  {}", rcb4::hex(frame), r.value()));
     else
       lines.push_back(fmt::format("{:<30}  (bad reply: {})", rcb4::hex(frame), rcb4::message(r.error)));
     rx_.erase(rx_.begin(), rx_.begin() + static_cast<std::ptrdiff_t>(frame.size()));

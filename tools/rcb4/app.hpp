@@ -299,6 +299,7 @@ void add_project_commands(CLI::App& app, context& ctx);     ///< project import|
 void add_trim_import(CLI::App* trim, context& ctx);         ///< trim import (cmd_project.cpp)
 void add_startup_command(CLI::App* motion, context& ctx);   ///< motion startup (cmd_startup.cpp)
 void add_flowchart_import(CLI::App* motion, context& ctx);  ///< motion import (cmd_project.cpp)
+void add_motion_check_command(CLI::App* motion, context& ctx);  ///< motion check (cmd_motion_check.cpp)
 // Shared by the robot commands (cmd_robot.cpp) and motion record (cmd_record.cpp).
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */
 bool wait_for_enter();

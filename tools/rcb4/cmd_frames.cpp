@@ -67,13 +67,13 @@ class decoder {
       const auto rep = rcb4::parse_reply(rest, *expected_);
       if (rep.status == rcb4::parse_status::complete) {
         expected_.reset();
-        return add("reply", rep.consumed, fmt::format("{}", rep.value));
+        return add("reply", rep.consumed, fmt::format("{}", rep.value()));
       }
     }
     const auto req = may_request ? rcb4::parse_command(rest) : rcb4::parse_result<rcb4::command>{};
     if (may_request && req.status == rcb4::parse_status::complete) {
-      expected_ = rcb4::expected_reply(req.value);
-      return add("request", req.consumed, fmt::format("{}", req.value));
+      expected_ = rcb4::expected_reply(req.value());
+      return add("request", req.consumed, fmt::format("{}", req.value()));
     }
     const auto rep = may_reply ? rcb4::parse_reply_frame(rest) : rcb4::parse_result<rcb4::reply>{};
     // A well-formed frame the codec refuses as a request (SINGLE to ICS 36) is not a data reply
@@ -82,7 +82,7 @@ class decoder {
                                  req.error != rcb4::errc::bad_checksum && !has_data_reply(rest[1]);
     if (may_reply && rep.status == rcb4::parse_status::complete && !refused_request) {
       expected_.reset();
-      return add("reply", rep.consumed, fmt::format("{}", rep.value));
+      return add("reply", rep.consumed, fmt::format("{}", rep.value()));
     }
     const auto& status = may_request ? req.status : rep.status;
     if (status == rcb4::parse_status::need_more &&

@@ -449,6 +449,7 @@ void add_motion_commands(CLI::App& app, context& ctx) {
   add_button_commands(motion, ctx);
   add_startup_command(motion, ctx);
   add_flowchart_import(motion, ctx);
+  add_motion_check_command(motion, ctx);
 }
 
 }  // namespace cli

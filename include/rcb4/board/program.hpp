@@ -87,7 +87,7 @@ class processor {
       if (!r.ok()) return program_error(m);
       ++stats.rom_steps;
       m.set_pc(static_cast<std::uint32_t>(at + size));
-      if (execute(m, s, r.value).kind == outcome::nack) {
+      if (execute(m, s, r.value()).kind == outcome::nack) {
         auto cfg = m.config();
         cfg.rom_program = false;  // an error in ROM clears ROM_F and stops the program (DOC-CMD)
         m.set_config(cfg);

@@ -80,7 +80,7 @@ class virtual_board {
         send(reply::nack(r.command), out);
         continue;
       }
-      if (!execute_from_com(r.value, out)) return;  // rebooted: the input buffer is gone
+      if (!execute_from_com(r.value(), out)) return;  // rebooted: the input buffer is gone
     }
     pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(used));
   }

@@ -54,8 +54,8 @@ class logic {
   }
   /** Value equality. */
   friend constexpr bool operator==(const logic&, const logic&) noexcept = default;
-  /** AND of RAM 0x0090 with itself, one byte. */
-  constexpr logic() noexcept = default;
+  /** No default: it writes RAM, so every operand is the caller's. */
+  logic() = delete;
 
  private:
   constexpr logic(logic_op op, detail::transfer t) noexcept : op_(op), t_(t) {}
@@ -109,8 +109,8 @@ class arith {
   }
   /** Value equality. */
   friend constexpr bool operator==(const arith&, const arith&) noexcept = default;
-  /** ADD of RAM 0x0090 to itself, one byte. */
-  constexpr arith() noexcept = default;
+  /** No default: it writes RAM, so every operand is the caller's. */
+  arith() = delete;
 
  private:
   constexpr arith(arith_op op, detail::transfer t) noexcept : op_(op), t_(t) {}
@@ -190,8 +190,8 @@ class bit_not {
   }
   /** Value equality. */
   friend constexpr bool operator==(const bit_not&, const bit_not&) noexcept = default;
-  /** NOT of one byte at RAM 0x0090. */
-  constexpr bit_not() noexcept = default;
+  /** No default: it writes RAM, so every operand is the caller's. */
+  bit_not() = delete;
 
  private:
   constexpr explicit bit_not(detail::unary_layout l) noexcept : l_(l) {}
@@ -255,8 +255,8 @@ class shift {
   }
   /** Value equality. */
   friend constexpr bool operator==(const shift&, const shift&) noexcept = default;
-  /** Shift of one byte at RAM 0x0090 by 0. */
-  constexpr shift() noexcept = default;
+  /** No default: it writes RAM, so every operand is the caller's. */
+  shift() = delete;
 
  private:
   constexpr shift(detail::unary_layout l, shift_count c, shift_encoding e) noexcept : l_(l), count_(c), enc_(e) {}

@@ -52,9 +52,11 @@ enum class update_flags : std::uint8_t {
 /**
  * A command type: a constexpr value that knows its CMD byte, its wire size, how to write the
  * bytes between CMD and SUM, what reply it expects, and how to read itself from a checked frame.
+ * Copyable and comparable, but not necessarily default-constructible: a command that acts (moves
+ * a servo, writes memory, jumps) has no default, so none is ever sent by accident.
  */
 template <class T>
-concept Command = std::regular<T> &&
+concept Command = std::copyable<T> && std::equality_comparable<T> &&
     requires(const T& c, detail::writer& w, std::span<const std::uint8_t> frame, const codec_options& opt) {
   { c.code() } -> std::same_as<std::uint8_t>;
   { c.wire_size() } -> std::same_as<std::size_t>;

@@ -86,7 +86,8 @@ class branch {
   /** To ROM address @p target when @p cond holds. */
   constexpr explicit branch(rom_address target, condition cond = condition::always()) noexcept
       : target_(target), cond_(cond) {}
-  constexpr branch() noexcept = default;
+  /** No default: it moves the board's program counter, so the target is the caller's. */
+  branch() = delete;
 
   /** The ROM address. */
   constexpr rom_address target() const noexcept { return target_; }

@@ -24,7 +24,8 @@ class single_servo {
   constexpr single_servo(ics_number n, servo_position pos, frames speed,
                          update_flags flags = update_flags::replace) noexcept
       : ics_(n), pos_(pos), speed_(speed), flags_(flags) {}
-  constexpr single_servo() noexcept = default;
+  /** No default: a SINGLE acts (it would move ICS 0), so every field is the caller's. */
+  single_servo() = delete;
 
   /** The servo slot. */
   constexpr ics_number ics() const noexcept { return ics_; }
@@ -124,8 +125,8 @@ class const_servo {
     return make(set, frames::make(f[7]).value(), m->flags);
   }
   friend constexpr bool operator==(const const_servo&, const const_servo&) noexcept = default;
-  /** ICS 0 to the centre at once. */
-  constexpr const_servo() noexcept { targets_.insert(ics_number{}, servo_position{}); }
+  /** No default: a CONST acts, so it comes from make() with at least one target. */
+  const_servo() = delete;
 
  private:
   friend class result<const_servo>;
@@ -161,10 +162,7 @@ class series_servo {
   static constexpr result<series_servo> make(series_opt_in_t, const servo_set<timed_position>& targets,
                                              update_flags flags = update_flags::replace) noexcept {
     if (targets.empty()) return errc::empty_servo_set;
-    series_servo c;
-    c.targets_ = targets;
-    c.flags_ = flags;
-    return c;
+    return series_servo(targets, flags);
   }
   /** Servo targets with their frames. */
   constexpr const servo_set<timed_position>& targets() const noexcept { return targets_; }
@@ -200,10 +198,11 @@ class series_servo {
     return make(series_opt_in, set, m->flags);
   }
   friend constexpr bool operator==(const series_servo&, const series_servo&) noexcept = default;
-  /** ICS 0 to the centre at once. */
-  constexpr series_servo() noexcept { targets_.insert(ics_number{}, timed_position{}); }
+  /** No default: a SERIES acts, so it comes from make() with at least one target. */
+  series_servo() = delete;
 
  private:
+  constexpr series_servo(const servo_set<timed_position>& t, update_flags f) noexcept : targets_(t), flags_(f) {}
   servo_set<timed_position> targets_{};
   update_flags flags_ = update_flags::replace;
 };
@@ -224,10 +223,7 @@ class servo_params {
   /** Sets @p kind to the values of @p values (at least one servo). */
   static constexpr result<servo_params> make(param_kind kind, const servo_set<servo_param>& values) noexcept {
     if (values.empty()) return errc::empty_servo_set;
-    servo_params c;
-    c.kind_ = kind;
-    c.values_ = values;
-    return c;
+    return servo_params(kind, values);
   }
   /** Which parameter. */
   constexpr param_kind kind() const noexcept { return kind_; }
@@ -262,10 +258,11 @@ class servo_params {
     return make(static_cast<param_kind>(f[7]), set);
   }
   friend constexpr bool operator==(const servo_params&, const servo_params&) noexcept = default;
-  /** Stretch of ICS 0 set to 1. */
-  constexpr servo_params() noexcept { values_.insert(ics_number{}, servo_param{}); }
+  /** No default: a SPEED/STRETCH acts, so it comes from make() with at least one servo. */
+  servo_params() = delete;
 
  private:
+  constexpr servo_params(param_kind k, const servo_set<servo_param>& v) noexcept : kind_(k), values_(v) {}
   param_kind kind_ = param_kind::stretch;
   servo_set<servo_param> values_{};
 };

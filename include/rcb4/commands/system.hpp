@@ -87,12 +87,7 @@ class ics_exchange {
                                              ram_address rx) noexcept {
     if (tx_length < 1 || tx_length > max_tx_length) return errc::ics_length_out_of_range;
     if (tx.value() + std::size_t{tx_length} > ram_size) return errc::ram_address_out_of_range;
-    ics_exchange c;
-    c.ics_ = n;
-    c.tx_length_ = tx_length;
-    c.tx_ = tx;
-    c.rx_ = rx;
-    return c;
+    return ics_exchange(n, tx_length, tx, rx);
   }
   /** The slot. */
   constexpr ics_number ics() const noexcept { return ics_; }
@@ -128,10 +123,12 @@ class ics_exchange {
     return make(*n, f[3], *tx, *rx);
   }
   friend constexpr bool operator==(const ics_exchange&, const ics_exchange&) noexcept = default;
-  /** One byte from 0x0090 to ICS 0, answer at 0x0090. */
-  constexpr ics_exchange() noexcept = default;
+  /** No default: it talks to a servo, so every field is the caller's. */
+  ics_exchange() = delete;
 
  private:
+  constexpr ics_exchange(ics_number n, std::uint8_t len, ram_address tx, ram_address rx) noexcept
+      : ics_(n), tx_length_(len), tx_(tx), rx_(rx) {}
   ics_number ics_{};
   std::uint8_t tx_length_ = 1;
   ram_address tx_ = detail::default_ram;

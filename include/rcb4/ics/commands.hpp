@@ -60,7 +60,8 @@ class set_position {
   }
   /** @p id goes limp. */
   static constexpr set_position free(servo_id id) noexcept { return set_position(id, position::free); }
-  constexpr set_position() noexcept = default;
+  /** No default: it moves a servo (ID 0 would move), so it comes from make() or free(). */
+  set_position() = delete;
   /** The servo. */
   constexpr servo_id id() const noexcept { return id_; }
   /** The position sent (0: free). */
@@ -147,7 +148,8 @@ class write_parameter {
     if (r.max == 0 || v < r.min || v > r.max) return errc::ics_value_out_of_range;
     return write_parameter(id, s, static_cast<std::uint8_t>(v));
   }
-  constexpr write_parameter() noexcept = default;
+  /** No default: it changes a servo, so it comes from make(). */
+  write_parameter() = delete;
   /** The servo. */
   constexpr servo_id id() const noexcept { return id_; }
   /** The parameter. */
@@ -253,7 +255,8 @@ class write_eeprom {
   static constexpr std::size_t reply_size = 2;     ///< servo bytes
   /** @p image to @p id. */
   constexpr write_eeprom(servo_id id, const eeprom_image& image) noexcept : id_(id), image_(image) {}
-  constexpr write_eeprom() noexcept = default;
+  /** No default: it rewrites a servo's EEPROM, so the ID and image are the caller's. */
+  write_eeprom() = delete;
   /** The servo. */
   constexpr servo_id id() const noexcept { return id_; }
   /** The image sent. */
@@ -313,7 +316,8 @@ class write_id {
   static constexpr std::size_t reply_size = 1;    ///< servo bytes
   /** Set the ID to @p id. */
   constexpr explicit write_id(servo_id id) noexcept : id_(id) {}
-  constexpr write_id() noexcept = default;
+  /** No default: it renumbers a servo, so the ID is the caller's. */
+  write_id() = delete;
   /** The new ID. */
   constexpr servo_id id() const noexcept { return id_; }
   /** The host's bytes. */
@@ -366,8 +370,7 @@ constexpr parse_result<typename Cmd::reply_type> parse_exchange(const Cmd& c,
     out.error = r.error();
     return out;
   }
-  out.status = parse_status::complete;
-  out.value = *r;
+  out.complete(*r);
   return out;
 }
 

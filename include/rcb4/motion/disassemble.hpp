@@ -79,7 +79,7 @@ inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, cons
       continue;
     }
     in.bytes.assign(rest.begin(), rest.begin() + static_cast<std::ptrdiff_t>(r.consumed));
-    in.cmd = r.value;
+    in.cmd = r.value();
     const std::uint32_t next = at + static_cast<std::uint32_t>(r.consumed);
     const auto follow = [&](std::uint32_t target) {
       if (target < base || target >= base + where.size)
@@ -87,7 +87,7 @@ inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, cons
       else
         todo.push_back(target);
     };
-    if (const auto* j = std::get_if<jump>(&r.value)) {
+    if (const auto* j = std::get_if<jump>(&r.value())) {
       const auto t = j->target().value();
       const bool other_slot_start = (t < base ? base - t : t - base) % where.size == 0;
       if ((t < base || t >= base + where.size) && other_slot_start) {
@@ -105,12 +105,12 @@ inline listing disassemble(std::span<const std::uint8_t> bytes, slot where, cons
         todo.push_back(next);
       else if (j->target().value() == at)
         out.notes.push_back(hex_address(at) + ": jumps to itself: the motion never ends (until it is stopped)");
-    } else if (const auto* c = std::get_if<call>(&r.value)) {
+    } else if (const auto* c = std::get_if<call>(&r.value())) {
       calls.insert(c->target().value());
       if (c->target().value() == base)
         out.notes.push_back(hex_address(at) + ": calls its own slot: every pass takes a level of the 16-deep stack");
       todo.push_back(next);
-    } else if (!std::holds_alternative<ret>(r.value)) {
+    } else if (!std::holds_alternative<ret>(r.value())) {
       todo.push_back(next);
     }
     out.code.push_back(std::move(in));

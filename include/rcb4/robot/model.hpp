@@ -13,6 +13,7 @@
 #pragma once
 
 #include <rcb4/ops/servos.hpp>
+#include <rcb4/robot/dynamics.hpp>
 #include <rcb4/robot/kinematics.hpp>
 #include <rcb4/values.hpp>
 
@@ -212,6 +213,15 @@ class model {
     body_ = std::move(k);
     return std::nullopt;
   }
+  /** The robot's mass model, when the profile gives one (it needs a body); else nullptr. */
+  const robot::dynamics* dynamics() const noexcept { return dynamics_ ? &*dynamics_ : nullptr; }
+  /** Gives the robot the mass model @p d, checked against its body (check_dynamics); its problem if unsound. */
+  std::optional<std::string> attach_dynamics(robot::dynamics d) {
+    if (!body_) return std::string("a mass model (dynamics:) needs the body (kinematics:)");
+    if (auto p = check_dynamics(d, *body_)) return p;
+    dynamics_ = std::move(d);
+    return std::nullopt;
+  }
 
  private:
   std::string name_;
@@ -220,6 +230,7 @@ class model {
   std::vector<motion_name> motions_;
   std::vector<mimic_joint> mimics_;
   std::optional<kinematics> body_;
+  std::optional<robot::dynamics> dynamics_;
 };
 
 // ---------------------------------------------------------------------------------------------

@@ -104,7 +104,7 @@ ics::servo_id ics_servo::read_id(bool for_id_write) {
                               where, hex(rx)),
                   for_id_write ? "leave one servo alone on the adapter for ID work (docs/ics-servos.md)"
                                : "name the servo with --id N (`rcb4 ics scan` lists them)");
-  return p.value;
+  return p.value();
 }
 
 ics::servo_id ics_servo::set_id(ics::servo_id id) {

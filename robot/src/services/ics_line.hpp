@@ -103,7 +103,7 @@ typename Cmd::reply_type ics_servo::ask(const Cmd& c, std::chrono::milliseconds 
                          rx.empty() ? std::string("nothing") : hex(rx));
       answered = true;
     } else if (p.ok() && rx.size() == p.consumed) {
-      return p.value;
+      return p.value();
     } else if (p.ok()) {
       last = fmt::format("{} bytes more than the reply came back ({}): another device answered too",
                          rx.size() - p.consumed, hex(std::span(rx).subspan(p.consumed)));

@@ -94,6 +94,14 @@ TEST_CASE("body: URDF in metres and radians, every joint with its limits", "[pro
   for (auto at = u.find("type=\"revolute\""); at != std::string::npos; at = u.find("type=\"revolute\"", at + 1))
     ++joints;
   CHECK(joints == m.joints().size());
+  // The mass model in URDF's units: the left thigh's 90.97 g at (2.59, -16.50, -33.76) mm, its
+  // inertia 59, 56, 13 kg*mm^2 with ixz 4 (MasutaniLab's l_upperreg), in kg, m and kg*m^2.
+  CHECK(u.find("<link name=\"khr_left_thigh\">\n    <inertial><origin xyz=\"0.00259 -0.0165 -0.03376\" rpy=\"0 0 0\"/>"
+               "<mass value=\"0.09097\"/><inertia ixx=\"5.9e-05\" ixy=\"0\" ixz=\"4e-06\" iyy=\"5.6e-05\" iyz=\"0\" "
+               "izz=\"1.3e-05\"/></inertial>") != std::string::npos);
+  std::size_t inertials = 0;
+  for (auto at = u.find("<inertial>"); at != std::string::npos; at = u.find("<inertial>", at + 1)) ++inertials;
+  CHECK(inertials == m.body()->links.size());
   const auto bare = parse_profile("robot: t\njoints:\n  a: {ics: 1, lower: -1, upper: 1}\n", "t.yaml");
   CHECK_THROWS_WITH(to_urdf(bare), Catch::Contains("has no kinematics"));
 }

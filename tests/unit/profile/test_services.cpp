@@ -37,9 +37,8 @@ class clocked_link final : public sv::link {
     const auto r = rcb4::parse_reply(out_, rcb4::expected_reply(c));
     if (r.status != rcb4::parse_status::complete)
       throw std::system_error(make_error_code(rcb4::errc::bad_reply_length));
-    last_ = r.value;
     ++exchanges;
-    return last_;
+    return r.value();  // points into out_, which lives until the next exchange
   }
   /** Moves the clock to @p t (never back) and lets the board run to it. */
   void at(rcb4::board::board_time t) {
@@ -53,7 +52,6 @@ class clocked_link final : public sv::link {
   rcb4::board::virtual_board& b_;
   rcb4::board::board_time now_{};
   std::vector<std::uint8_t> out_;
-  rcb4::reply last_;
 };
 
 rcb4::board::virtual_board khr_board(const rcb4::robot::model& m) {

@@ -5,6 +5,7 @@
 #include <rcb4/motion/buttons.hpp>
 #include <rcb4/motion/disassemble.hpp>
 #include <rcb4/ops/layout.hpp>
+#include <rcb4/robot/motion_balance.hpp>
 #include <rcb4/robot/motion_file.hpp>
 #include <rcb4/robot/services/buttons.hpp>
 #include <rcb4/robot/services/motion_slots.hpp>
@@ -295,6 +296,18 @@ json studio_ops::check(const std::string& text) {
   const auto period = sv::run(link_, rcb4::ops::read_config{}).period;
   const auto c = robot::to_program(d, m_, *o_.layout, period, true);
   json out{{"motion", json::parse(robot::motion_json(d))}, {"yaml", robot::motion_yaml(d)}};
+  // Does it stand? Each pose held still (robot/motion_balance.hpp), for the editor to mark.
+  out["balance"] = nullptr;
+  if (m_.body() && m_.dynamics()) {
+    json poses = json::array();
+    for (const auto& p : robot::check_balance(d, m_).poses)
+      poses.push_back({{"step", p.step},
+                       {"margin_mm", std::round(p.at.margin * 10) / 10},
+                       {"stable", p.at.stable()},
+                       {"tilt_deg", std::round(p.at.tilt * 10) / 10},
+                       {"touching", p.at.touching}});
+    out["balance"] = poses;
+  }
   if (!robot::ok(c)) {
     out["problem"] = std::get<robot::problem>(c).message;
     return out;

@@ -10,6 +10,7 @@ import { createFlowchart, flowMove, flowShift, fromFile, toFile } from './flowch
 import { el, $, numberIn } from './dom.js';
 import { KINDS, describe, kindOf, segments } from './steps.js';
 import { createPlayback } from './playback.js';
+import { createBalance } from './balance.js';
 
 /** The largest motion file the editor opens (the server's max_text_bytes, docs/browser.md). */
 const MAX_FILE_BYTES = 512 * 1024;
@@ -18,6 +19,7 @@ export function createEditor(root, ctx) {
   const h = ctx.hello;
   const limits = new Map(h.joints.map((j) => [j.name, j]));
   const ed = { doc: { robot: h.robot, name: '', period_ms: 10, steps: ['end'] }, sel: 0, undo: [], redo: [], preview: null, run: 0, playing: false };
+  let balance = null;  // the balance marks (balance.js), made once the page's parts exist
 
   // --- the parts of the panel ---
   const name = el('input', { id: 'ed-name', placeholder: 'motion name (names its slot)', maxlength: 64, 'aria-label': 'motion name' });
@@ -288,7 +290,7 @@ export function createEditor(root, ctx) {
     const poses = ed.doc.steps.map((s, i) => [s, i]).filter(([s]) => kindOf(s) === 'pose');
     const total = poses.reduce((a, [s]) => a + s.time_ms, 0) || 1;
     timeline.replaceChildren(cursor, ...poses.map(([s, i]) => {
-      const b = el('div', { class: 'block' + (i === ed.sel ? ' selected' : ''), title: `step ${i + 1}${s.name ? ` (${s.name})` : ''}: ${s.time_ms} ms`, text: s.name || String(i + 1) });
+      const b = el('div', { class: 'block' + (i === ed.sel ? ' selected' : ''), 'data-step': i, title: `step ${i + 1}${s.name ? ` (${s.name})` : ''}: ${s.time_ms} ms`, text: s.name || String(i + 1) });
       b.style.flexGrow = String(Math.max(s.time_ms, 1) / total);
       b.addEventListener('click', () => { ed.sel = i; render(); });
       return b;
@@ -308,6 +310,7 @@ export function createEditor(root, ctx) {
       if (key !== ed.liveSent) { ed.liveSent = key; sendLive(cur.pose); }
     }
     ctx.controls();
+    balance?.schedule();
   }
 
   function drawJumps() {
@@ -525,6 +528,10 @@ export function createEditor(root, ctx) {
   // --- preview, play, stop: playback.js ---
   const playback = createPlayback(ed, ctx, text, cursor, poseAt);
   const { preview, play, stop } = playback;
+  // --- does it stand? balance.js ---
+  const balanceLine = el('div', { id: 'ed-balance', class: 'small' });
+  summary.after(balanceLine);
+  balance = createBalance(ctx, text, balanceLine, [steps, timeline]);
   root.append(el('div', { id: 'ed-result', class: 'small muted' }));
 
   render();

@@ -12,6 +12,8 @@
 // all hold on the same value, and `std::error_code s = ec;` works for std-only code.
 #pragma once
 
+#include <rcb4/error_category.hpp>
+
 #include <boost/asio/error.hpp>
 #include <boost/system/error_code.hpp>
 #include <boost/system/system_error.hpp>

@@ -210,7 +210,7 @@ class share_server : public std::enable_shared_from_this<share_server<Client>> {
       const std::size_t used = r.status == parse_status::complete ? r.consumed : std::max<std::size_t>(r.consumed, 1);
       c->pending.erase(c->pending.begin(),
                        c->pending.begin() + static_cast<std::ptrdiff_t>(std::min(used, c->pending.size())));
-      if (r.status == parse_status::complete) relay(c, r.value);
+      if (r.status == parse_status::complete) relay(c, r.value());
     }
   }
 

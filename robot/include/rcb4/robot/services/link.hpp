@@ -16,6 +16,7 @@
 // exception class); a failure of the line is whatever the link throws.
 #pragma once
 
+#include <rcb4/error_category.hpp>
 #include <rcb4/ops/operation.hpp>
 
 #include <cstddef>

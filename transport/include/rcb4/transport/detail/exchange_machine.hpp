@@ -350,7 +350,7 @@ class exchange_machine {
       return attempt_failed(p.error, now);
     }
     if (p.consumed < got.size()) dirty_ = true;  // bytes after the reply (a NACK read where data was due)
-    reply_ = response::from(p.value);
+    reply_ = response::from(p.value());
     if (reply_.kind == reply_kind::nack) ++n_->nacks;
     return finish({});
   }
