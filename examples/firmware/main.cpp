@@ -68,7 +68,7 @@ std::optional<rcb4::reply> exchange(const rcb4::command& cmd, std::uint32_t time
     const std::uint32_t deadline = mps2::now_ms() + timeout_ms;
     for (;;) {
       const auto p = rcb4::parse_reply({g_rx, have}, shape);
-      if (p.ok()) return p.value;
+      if (p.ok()) return p.value();
       if (p.status == rcb4::parse_status::error) {
         mps2::line l;
         l << "firmware: malformed reply: " << rcb4::message(p.error);
@@ -132,21 +132,25 @@ extern "C" int firmware_main() {
       << static_cast<long>(milliseconds(config.value().period)) << " ms)";
   out.print();
 
-  // 3. every servo's state, planned reads.
-  ops::read_servo_states_fixed states;
-  run(states, "read servos");
-  (out << "servos: " << static_cast<long>(states.value().size()) << " allocated, read in "
-       << static_cast<long>(states.plan().size()) << " planned reads")
-      .print();
-  for (const auto& s : states.value()) {
-    out << "  ICS " << static_cast<long>(s.ics.value()) << ": position " << static_cast<long>(s.position) << " target "
-        << static_cast<long>(s.target);
-    out.print();
+  // 3. every servo's state, planned reads (in a scope of its own: the reads in step 4 reuse its stack).
+  ics_number a{}, b{};
+  {
+    ops::read_servo_states_fixed states;
+    run(states, "read servos");
+    (out << "servos: " << static_cast<long>(states.value().size()) << " allocated, read in "
+         << static_cast<long>(states.plan().size()) << " planned reads")
+        .print();
+    for (const auto& s : states.value()) {
+      out << "  ICS " << static_cast<long>(s.ics.value()) << ": position " << static_cast<long>(s.position)
+          << " target " << static_cast<long>(s.target);
+      out.print();
+    }
+    if (states.value().size() < 2) fail(outcome::too_few_servos, "fewer than two servos allocated");
+    a = states.value()[0].ics;
+    b = states.value()[1].ics;
   }
-  if (states.value().size() < 2) fail(outcome::too_few_servos, "fewer than two servos allocated");
 
   // 4. two servos, one CONST frame: the first to +1000 counts from centre, the second to -1000.
-  const ics_number a = states.value()[0].ics, b = states.value()[1].ics;
   const auto goal_a = servo_position::make(servo_position::centre_value + 1000).value();
   const auto goal_b = servo_position::make(servo_position::centre_value - 1000).value();
   servo_set<servo_position> targets;

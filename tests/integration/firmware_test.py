@@ -7,6 +7,7 @@
 # standin.py over TCP): silent, NACK, bad checksums; each must end in its documented exit status.
 #   firmware_test.py FIRMWARE.elf RCB4 [arm-none-eabi-size]
 # SPDX-License-Identifier: BSL-1.0
+import glob
 import json
 import os
 import shutil
@@ -27,15 +28,39 @@ if QEMU is None:
     print("SKIPPED: qemu-system-arm is not installed (cmake/install-deps.sh installs it)")
     sys.exit(77)
 
+# Budgets (docs/firmware.md), set from the figures measured on 2026-11-28 (11,360 bytes of code,
+# 0 of data, 260 of bss, a worst stack of 3,848 bytes) with a little room: a change that grows
+# the image or its stack past them must say why, here and in the docs.
+BUDGET_TEXT, BUDGET_DATA, BUDGET_BSS, BUDGET_STACK = 12000, 0, 288, 4096
+
 if SIZE:
     out = subprocess.run([SIZE, ELF], capture_output=True, text=True).stdout.split("\n")
     text, data, bss = out[1].split()[:3]
     print(f"firmware image: {text} bytes of code, {data} of data, {bss} of bss ({os.path.basename(ELF)})")
+    check(int(text) <= BUDGET_TEXT and int(data) <= BUDGET_DATA and int(bss) <= BUDGET_BSS,
+          f"the image within its budget: code {text} <= {BUDGET_TEXT}, data {data} <= {BUDGET_DATA}, "
+          f"bss {bss} <= {BUDGET_BSS}")
     # No heap: nothing in the image allocates (malloc, operator new) or grows one (_sbrk).
     nm = subprocess.run([SIZE[:-len("size")] + "nm", ELF], capture_output=True, text=True).stdout.split()
     heap = sorted({s for s in nm if s in ("malloc", "_malloc_r", "calloc", "realloc", "_sbrk", "_sbrk_r", "_Znwj", "_Znaj",
                                           "_ZnwjRKSt9nothrow_t", "_ZnajRKSt9nothrow_t", "free")})
     check(nm and not heap, f"the image has no heap: no malloc, operator new or _sbrk ({heap})")
+
+
+# The worst stack, from GCC's call graph (-fcallgraph-info=su): the deepest path from the reset
+# handler plus the interrupts on top (tests/support/stack_usage.py).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "support"))
+import stack_usage  # noqa: E402
+
+graphs = sorted(glob.glob(ELF + "-*.ci"))
+check(len(graphs) == 2, f"the build wrote the firmware's call graphs ({[os.path.basename(g) for g in graphs]})")
+if graphs:
+    stack, main_bytes, path, handlers, problems, indirect = stack_usage.analyse(graphs)
+    print(f"firmware worst stack: {stack} bytes ({main_bytes} on the deepest path from reset, then the interrupts); the path:")
+    for step in path:
+        print("    " + step)
+    check(not problems, f"every path's stack is bounded: no recursion, no dynamic frame ({problems})")
+    check(stack <= BUDGET_STACK, f"the worst stack within its budget: {stack} <= {BUDGET_STACK} bytes")
 
 
 def firmware(address):

@@ -25,6 +25,8 @@ class fixed_vector {
   }
   /** Removes every value. */
   constexpr void clear() noexcept { size_ = 0; }
+  /** Keeps the first @p n values (n ≤ N; values past the old size are whatever the storage holds). */
+  constexpr void resize(std::size_t n) noexcept { size_ = n < N ? n : N; }
   /** How many values are held. */
   constexpr std::size_t size() const noexcept { return size_; }
   /** True when none is held. */

@@ -49,7 +49,9 @@ namespace detail {
  */
 inline std::optional<std::size_t> plan_parts(std::span<byte_range> wanted, std::uint32_t limit,
                                              std::span<byte_range> out) noexcept {
-  std::sort(wanted.begin(), wanted.end(), [](auto& a, auto& b) { return a.address < b.address; });
+  // Insertion sort: a few dozen ranges, no recursion (a firmware's worst stack stays a number).
+  for (std::size_t i = 1; i < wanted.size(); ++i)
+    for (std::size_t j = i; j > 0 && wanted[j].address < wanted[j - 1].address; --j) std::swap(wanted[j], wanted[j - 1]);
   std::size_t n = 0;
   bool overflow = false;
   const auto emit = [&](byte_range x) {
@@ -124,6 +126,26 @@ inline std::vector<byte_range> plan_reads(std::vector<byte_range> wanted, link_c
 }
 
 /**
+ * plan_reads without the heap, written into @p out in place (for firmware): @p wanted is sorted
+ * in place, and the scratch on the stack is about 20 bytes a range. False (out empty) when more
+ * than N ranges are wanted or the plan needs more than N parts before merging reads.
+ */
+template <std::size_t N>
+bool plan_reads_into(std::span<byte_range> wanted, link_cost cost, fixed_vector<byte_range, N>& out,
+                     std::uint32_t read_limit = 128) noexcept {
+  out.clear();
+  if (wanted.size() > N) return false;
+  std::array<byte_range, N> parts{};
+  const auto n = detail::plan_parts(wanted, read_limit, parts);
+  if (!n) return false;
+  std::array<std::int64_t, N + 1> best{};
+  std::array<std::size_t, N + 1> from{};
+  out.resize(N);
+  out.resize(detail::choose_reads({parts.data(), *n}, cost, read_limit, best, from, {out.data(), N}));
+  return true;
+}
+
+/**
  * plan_reads without the heap (for firmware): the same reads, held inline; nothing when more
  * than N ranges are wanted or the plan needs more than N parts before merging reads.
  */
@@ -133,15 +155,8 @@ std::optional<fixed_vector<byte_range, N>> plan_reads_fixed(std::span<const byte
   if (wanted.size() > N) return std::nullopt;
   std::array<byte_range, N> sorted{};
   std::copy(wanted.begin(), wanted.end(), sorted.begin());
-  std::array<byte_range, N> parts{};
-  const auto n = detail::plan_parts({sorted.data(), wanted.size()}, read_limit, parts);
-  if (!n) return std::nullopt;
-  std::array<std::int64_t, N + 1> best{};
-  std::array<std::size_t, N + 1> from{};
-  std::array<byte_range, N> out{};
-  const auto count = detail::choose_reads({parts.data(), *n}, cost, read_limit, best, from, out);
   fixed_vector<byte_range, N> plan;
-  for (std::size_t i = 0; i < count; ++i) plan.push_back(out[i]);
+  if (!plan_reads_into<N>({sorted.data(), wanted.size()}, cost, plan, read_limit)) return std::nullopt;
   return plan;
 }
 

@@ -80,7 +80,8 @@ inline result<fixed_vector<servo_slot, 35>> parse_allocation_table_fixed(std::sp
     slots.push_back({ics_number::make(k).value(), a});
     at[n++] = a;
   }
-  std::sort(at.begin(), at.begin() + static_cast<std::ptrdiff_t>(n));
+  for (std::size_t i = 1; i < n; ++i)  // insertion sort: 35 words at most, no recursion
+    for (std::size_t j = i; j > 0 && at[j] < at[j - 1]; --j) std::swap(at[j], at[j - 1]);
   for (std::size_t i = 1; i < n; ++i)
     if (at[i] < at[i - 1] + servo_block::size) return errc::bad_allocation_table;
   return slots;
@@ -159,12 +160,14 @@ class planned_reads : public basic_planned_reads<std::vector<byte_range>> {
 };
 
 /**
- * Reads the allocation table, then @p size bytes (at most 20) at @p offset of every allocated
- * block, in the reads plan_reads chooses for the link: the shape of read_servo_states and
- * scan_slots. No heap.
+ * Reads the allocation table, then @p size bytes (at most max_field) at @p offset of every
+ * allocated block, in the reads plan_reads chooses for the link: the shape of read_servo_states
+ * and scan_slots. No heap, and no RAM mirror: it keeps only the bytes asked for (max_field a
+ * block), taken from each reply as it comes; the plan is made in place.
  */
 class table_then_reads {
  public:
+  static constexpr std::uint32_t max_field = 8;  ///< the most bytes of each block a reader keeps
   /** The fields [offset, offset + size) of each block, planned for @p cost. */
   table_then_reads(std::uint32_t offset, std::uint32_t size, link_cost cost)
       : offset_(offset), size_(size), cost_(cost) {}
@@ -172,44 +175,71 @@ class table_then_reads {
   std::optional<command> next() const {
     if (error_ != errc{}) return std::nullopt;
     if (!table_read_) return read_allocation();
-    return reads_.next();
+    if (step_ >= plan_.size()) return std::nullopt;
+    return command{move::read_ram(ram_address::make(plan_[step_].address).value(),
+                                  transfer_size::make(plan_[step_].size).value())
+                       .value()};
   }
   /** Takes a reply; true when the last read is in (slots() and word() are then ready). */
   bool on_reply(const reply& r) {
     if (!table_read_) {
       const auto slots = allocated_slots_fixed(r);
       if ((error_ = slots.error()) != errc{}) return false;
-      slots_ = *slots;
-      std::array<byte_range, 35> wanted{};
-      for (std::size_t i = 0; i < slots_.size(); ++i) wanted[i] = {slots_[i].address + offset_, size_};
-      // 35 ranges of at most 128 bytes each never need more than 35 parts.
-      const auto plan = plan_reads_fixed<35>({wanted.data(), slots_.size()}, cost_);
-      if (!plan) {
-        error_ = errc::transfer_size_out_of_range;  // a field wider than one read: a caller's mistake
+      if (size_ == 0 || size_ > max_field) {
+        error_ = errc::transfer_size_out_of_range;  // a field wider than a reader keeps: a caller's mistake
         return false;
       }
-      reads_ = basic_planned_reads(*plan);
+      slots_ = *slots;
+      // The wanted ranges are built where the plan goes, then planned in place: 35 ranges of at
+      // most 8 bytes never need more than 35 parts.
+      plan_.resize(slots_.size());
+      for (std::size_t i = 0; i < slots_.size(); ++i) plan_[i] = {slots_[i].address + offset_, size_};
+      // (plan_parts reads them into its parts before choose_reads writes the plan over them.)
+      plan_reads_into<35>({plan_.data(), slots_.size()}, cost_, plan_);
       table_read_ = true;
-      return reads_.done();
+      return step_ >= plan_.size();
     }
-    return (error_ = reads_.on_reply(r)) == errc{} && reads_.done();
+    if (const auto e = check_reply(r, true, plan_[step_].size); e != errc{}) {
+      error_ = e;
+      return false;
+    }
+    // Each kept byte the read covers (a field may span two reads: kept byte by byte).
+    const std::uint32_t from = plan_[step_].address, to = from + plan_[step_].size;
+    for (std::size_t i = 0; i < slots_.size(); ++i)
+      for (std::uint32_t k = 0; k < size_; ++k) {
+        const std::uint32_t a = slots_[i].address + offset_ + k;
+        if (a >= from && a < to) fields_[i * max_field + k] = r.bytes()[a - from];
+      }
+    ++step_;
+    return step_ >= plan_.size();
   }
   /** errc{} or what went wrong. */
   errc error() const noexcept { return error_; }
   /** The allocated slots, ascending by ICS. */
   std::span<const servo_slot> slots() const noexcept { return slots_.view(); }
-  /** The 16-bit word read at RAM @p a. */
-  std::uint16_t word(std::uint32_t a) const { return reads_.word(a); }
+  /** The 16-bit word read at RAM @p a (inside a block's kept field; 0 elsewhere). */
+  std::uint16_t word(std::uint32_t a) const noexcept {
+    for (std::size_t i = 0; i < slots_.size(); ++i) {
+      const std::uint32_t f = slots_[i].address + offset_;
+      if (a >= f && a + 2 <= f + size_) {
+        const auto k = i * max_field + (a - f);
+        return static_cast<std::uint16_t>(fields_[k] | (fields_[k + 1] << 8));
+      }
+    }
+    return 0;
+  }
   /** The reads chosen after the table. */
-  const fixed_vector<byte_range, 35>& plan() const noexcept { return reads_.plan(); }
+  const fixed_vector<byte_range, 35>& plan() const noexcept { return plan_; }
 
  private:
   std::uint32_t offset_;
   std::uint32_t size_;
   link_cost cost_;
   bool table_read_ = false;
+  std::size_t step_ = 0;
   fixed_vector<servo_slot, 35> slots_;
-  basic_planned_reads<fixed_vector<byte_range, 35>> reads_;
+  fixed_vector<byte_range, 35> plan_;
+  std::array<std::uint8_t, 35 * max_field> fields_{};
   errc error_{};
 };
 }  // namespace detail
