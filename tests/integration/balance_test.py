@@ -54,11 +54,12 @@ steps:
 rc, out, err = run("motion", "check", "squat.yaml")
 check(rc == 0 and "squat.yaml on KHR-3HV (1458 g): 2 poses" in out and "stands: every pose" in out
       and "OUTSIDE" not in out, f"a squat stands: exit 0 ({rc}: {out[-300:]!r} {err[-200:]!r})")
-check("left_foot+right_foot" in out and "squat" in out and "note: 14 joints no pose names before the first" in out,
+check("left_foot+right_foot" in out and "squat" in out and "note: the first pose leaves 14 joints unnamed" in out,
       f"each pose's feet and name; the joints taken at home are counted ({out[:400]!r})")
 
 rc, out, err = run("motion", "check", "lean.yaml")
-check(rc == 5 and "falls: step 2's centre of mass lies" in out and "OUTSIDE its feet" in out,
+check(rc == 5 and "falls: 1 of 2 poses off their feet; the worst, step 2's" in out and "OUTSIDE its feet" in out
+      and "80.0° " in out,
       f"hips pitched 80 degrees fall: exit 5 naming step 2 ({rc}: {out[-300:]!r} {err[-200:]!r})")
 
 rc, out, err = run("--json", "motion", "check", "lean.yaml")
@@ -69,7 +70,8 @@ except ValueError:
 poses = j.get("poses", [])
 check(rc == 5 and j.get("stands") is False and j.get("worst_step") == 2 and len(poses) == 2
       and poses[0]["stable"] and not poses[1]["stable"] and poses[1]["margin_mm"] < 0
-      and abs(poses[1]["tilt_deg"] - 80) < 1 and poses[0]["touching"] == ["left_foot", "right_foot"]
+      and abs(poses[1]["tilt_deg"] - 80) < 1 and abs(abs(poses[1]["lean_forward_deg"]) - 80) < 1
+      and abs(poses[0]["com_mm"][1]) < 0.5 and poses[0]["touching"] == ["left_foot", "right_foot"]
       and j.get("physics") is False and j.get("mass_g") == 1458,
       f"--json: each pose's margin, tilt and feet ({rc}: {out[:600]!r})")
 
@@ -94,6 +96,8 @@ joints:
 write("bare_motion.yaml", "robot: bare\nperiod_ms: 10\nsteps:\n  - pose: {left_knee: 10}\n    time_ms: 100\n")
 rc, out, err = run("--robot", "bare.yaml", "motion", "check", "bare_motion.yaml")
 check(rc == 2 and "no mass model (dynamics:)" in err, f"a profile without dynamics: exit 2 ({rc}: {err[-200:]!r})")
+rc, out, err = run("motion", "check", "121")
+check(rc == 2 and "1..120" in err, f"a number outside 1..120: exit 2 saying so ({rc}: {err[-200:]!r})")
 rc, out, err = run("motion", "check", "missing.yaml")
 check(rc == 2 and "missing.yaml" in err, f"no such file: exit 2 naming it ({rc}: {err[-200:]!r})")
 rc, out, err = run("motion", "check", "bare_motion.yaml")

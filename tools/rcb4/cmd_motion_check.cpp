@@ -41,6 +41,16 @@ std::string feet_text(const ro::balance& b) {
   return out;
 }
 
+/** Which way the torso leans: "upright", "12.0° forward", "5.0° back, 3.0° left". */
+std::string lean_text(const ro::balance& b) {
+  std::string out;
+  if (std::abs(b.lean_forward) >= 0.05)
+    out = fmt::format("{:.1f}° {}", std::abs(b.lean_forward), b.lean_forward > 0 ? "forward" : "back");
+  if (std::abs(b.lean_left) >= 0.05)
+    out += fmt::format("{}{:.1f}° {}", out.empty() ? "" : ", ", std::abs(b.lean_left), b.lean_left > 0 ? "left" : "right");
+  return out.empty() ? "upright" : out;
+}
+
 int report(const ro::motion_balance& r, const std::string& what, const ro::model& robot, const globals& g) {
   const auto* worst = r.worst();
   if (g.json) {
@@ -51,6 +61,8 @@ int report(const ro::motion_balance& r, const std::string& what, const ro::model
                        {"margin_mm", std::round(p.at.margin * 10) / 10},
                        {"stable", p.at.stable()},
                        {"tilt_deg", std::round(p.at.tilt * 10) / 10},
+                       {"lean_forward_deg", std::round(p.at.lean_forward * 10) / 10},
+                       {"lean_left_deg", std::round(p.at.lean_left * 10) / 10},
                        {"com_mm", {std::round(p.at.com[0] * 10) / 10, std::round(p.at.com[1] * 10) / 10,
                                    std::round(p.at.com[2] * 10) / 10}},
                        {"touching", p.at.touching}});
@@ -67,20 +79,23 @@ int report(const ro::motion_balance& r, const std::string& what, const ro::model
     fmt::print("{} on {} ({:.0f} g): {} pose{}, each held still (no physics)\n", what, robot.name(), r.mass,
                r.poses.size(), r.poses.size() == 1 ? "" : "s");
     if (!r.assumed.empty())
-      fmt::print("note: {} joint{} no pose names before the first: taken at 0 (home)\n", r.assumed.size(),
+      fmt::print("note: the first pose leaves {} joint{} unnamed: taken at 0 (home)\n", r.assumed.size(),
                  r.assumed.size() == 1 ? "" : "s");
-    fmt::print("{:>5}  {:<16} {:>10}  {:>6}  {}\n", "step", "name", "margin", "tilt", "on the floor");
+    fmt::print("{:>5}  {:<16} {:>10}  {:<16}  {}\n", "step", "name", "margin", "torso leans", "on the floor");
     for (const auto& p : r.poses)
-      fmt::print("{:>5}  {:<16} {:>+7.1f} mm  {:>5.1f}°  {}{}\n", p.step + 1, p.name.empty() ? "-" : p.name,
-                 p.at.margin, p.at.tilt, feet_text(p.at), p.at.stable() ? "" : "   OUTSIDE its feet: falls");
+      fmt::print("{:>5}  {:<16} {:>+7.1f} mm  {:<16}  {}{}\n", p.step + 1, p.name.empty() ? "-" : p.name.substr(0, 16),
+                 p.at.margin, lean_text(p.at), feet_text(p.at), p.at.stable() ? "" : "   OUTSIDE its feet: falls");
     if (!worst)
-      fmt::print("no pose to check\n");
+      fmt::print("no pose to check: the motion has none\n");
     else if (r.stands())
       fmt::print("stands: every pose's centre of mass lies over its feet (smallest margin {:.1f} mm, step {})\n",
                  worst->at.margin, worst->step + 1);
-    else
-      fmt::print("falls: step {}'s centre of mass lies {:.1f} mm outside its feet\n", worst->step + 1,
-                 -worst->at.margin);
+    else {
+      std::size_t falls = 0;
+      for (const auto& p : r.poses) falls += p.at.stable() ? 0U : 1U;
+      fmt::print("falls: {} of {} poses off their feet; the worst, step {}'s centre of mass, {:.1f} mm outside\n",
+                 falls, r.poses.size(), worst->step + 1, -worst->at.margin);
+    }
   }
   return r.stands() ? exit_ok : exit_falls;
 }
@@ -97,6 +112,8 @@ void add_motion_check_command(CLI::App* motion, context& ctx) {
   add_layout(cmd, o->m);
   cmd->callback([&ctx, o] {
     const auto n = slot_of(o->what);
+    if (!n && !o->what.empty() && o->what.find_first_not_of("0123456789") == std::string::npos)
+      throw usage_error(fmt::format("N: {} is not a motion's number (1..120)", o->what));
     const auto& robot = robot_of(ctx.g);
     if (!robot.dynamics())
       throw usage_error(fmt::format("the profile of {} has no mass model (dynamics:): nothing to check balance with "

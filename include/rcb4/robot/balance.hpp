@@ -4,11 +4,11 @@
 // polygon). std only, no I/O; every build tests it. physics.md §7.
 // SPDX-License-Identifier: BSL-1.0
 //
-// The robot is set down flat on a sole: the floor is the bottom of a sole no other reaches below,
-// so a pose that lifts a foot stands on the other and a pose that leans the legs tilts the torso.
-// A sole touches when one of its bottom corners is within `contact_mm` of the floor. Margin: the
-// signed distance in mm from the centre of mass (projected on the floor) to the nearest edge of
-// the convex hull of the touching corners; positive inside, negative outside.
+// The robot rests on the floor as a rigid body: on the face of the convex hull of its sole corners
+// that tilts it least from upright (a pose that lifts a foot stands on the other; feet spread
+// apart stand on their inner edges). A corner within `contact_mm` (1 mm) of that face touches.
+// Margin: the signed distance in mm from the centre of mass (projected on the floor) to the
+// nearest edge of the convex hull of the touching corners; positive inside, negative outside.
 #pragma once
 
 #include <rcb4/robot/dynamics.hpp>
@@ -115,15 +115,20 @@ inline std::vector<frame> link_frames(const kinematics& k, const std::map<std::s
 /** A point on the floor plane, mm. */
 using point2 = std::array<double, 2>;
 
-/** The balance of one pose, in the floor's frame (x forward, y left along the sole it stands on; z up from the floor). */
+/**
+ * The balance of one pose, in the floor's frame: its origin the point of the floor under the
+ * root link's origin, x the root's forward direction along the floor, y to its left, z up.
+ */
 struct balance {
   vec3 com{};                         ///< centre of mass: x, y over the floor, z its height, mm
   double mass = 0;                    ///< grams
-  std::string standing_on;            ///< the sole whose bottom is the floor
+  std::string standing_on;            ///< the sole with the most corners on the floor
   std::vector<point2> support;        ///< the support polygon, counter-clockwise
-  std::vector<std::string> touching;  ///< the soles on the floor
+  std::vector<std::string> touching;  ///< the soles with a corner on the floor
   double margin = 0;                  ///< mm from the centre of mass to the polygon's nearest edge; < 0: outside
   double tilt = 0;                    ///< degrees between the root link's z axis and the floor's normal
+  double lean_forward = 0;            ///< the root's z axis leaning forward (+) or back (−), degrees
+  double lean_left = 0;               ///< the root's z axis leaning left (+) or right (−), degrees
   /** True when the centre of mass lies over the support polygon. */
   bool stable() const noexcept { return margin > 0; }
 };
@@ -162,28 +167,30 @@ inline double to_segment(const point2& p, const point2& a, const point2& b) noex
   return std::sqrt(ex * ex + ey * ey);
 }
 
-/** @p p (in the root's frame) in the frame @p f: f's rotation transposed applied to p − f's origin. */
-inline vec3 into(const frame& f, const vec3& p) noexcept {
-  const vec3 d{p[0] - f.p[0], p[1] - f.p[1], p[2] - f.p[2]};
-  return {f.r[0] * d[0] + f.r[3] * d[1] + f.r[6] * d[2], f.r[1] * d[0] + f.r[4] * d[1] + f.r[7] * d[2],
-          f.r[2] * d[0] + f.r[5] * d[1] + f.r[8] * d[2]};
-}
 }  // namespace detail
 
 /**
  * The balance of the body @p k with masses @p d at joint angles @p degrees (body joint names,
- * degrees), standing still. The floor is the bottom face of a sole that no other sole reaches
- * below (the robot is set down flat on it); a sole touches when a bottom corner is within
- * @p contact_mm of the floor. Poses with no such sole (every foot tilted against the others)
- * stand on the root link held upright, the floor under the lowest corner.
+ * degrees), standing still. The robot rests on the floor as a rigid body would: the floor is a
+ * plane through three sole corners with every sole corner on or above it (a face of their convex
+ * hull), the least tilted. When the centre of mass lies outside it, the robot tips onto the next
+ * face that holds it if that is at most @p settle_deg further from upright (a lunge with one heel
+ * a few mm up), else it falls (the margin negative). So a pose that lifts a foot stands on the
+ * other, a pose that leans both legs tilts the torso, feet spread apart stand on their inner
+ * edges. A corner within @p contact_mm of the floor touches it.
  */
 inline balance balance_of(const kinematics& k, const dynamics& d, const std::map<std::string, double>& degrees,
-                          double contact_mm = 2.0) {
+                          double contact_mm = 1.0, double settle_deg = 5.0) {
   const auto frames = link_frames(k, degrees);
   const auto index_of = [&](const std::string& name) {
     for (std::size_t i = 0; i < k.links.size(); ++i)
       if (k.links[i].name == name) return i;
     return k.links.size();
+  };
+  const auto dot = [](const vec3& a, const vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+  const auto sub = [](const vec3& a, const vec3& b) { return vec3{a[0] - b[0], a[1] - b[1], a[2] - b[2]}; };
+  const auto crossv = [](const vec3& a, const vec3& b) {
+    return vec3{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
   };
   balance b;
   vec3 com{};
@@ -196,70 +203,101 @@ inline balance balance_of(const kinematics& k, const dynamics& d, const std::map
   }
   if (b.mass > 0)
     for (auto& v : com) v /= b.mass;
-  // Every sole's bottom corners in the root's frame, and the frame of each sole's bottom face.
-  struct sole_at {
-    const sole* s;
-    frame bottom;
-    std::array<vec3, 4> corners;
-  };
-  std::vector<sole_at> soles;
+  // Every sole's four bottom corners in the root's frame.
+  std::vector<std::pair<const sole*, vec3>> corners;
   for (const auto& s : d.soles) {
     const auto i = index_of(s.link);
     if (i >= frames.size()) continue;
-    sole_at a{&s, frames[i], {}};
-    a.bottom.p = frames[i].apply({s.xyz[0], s.xyz[1], s.xyz[2] - s.size[2] / 2});
     for (int c = 0; c < 4; ++c)
-      a.corners[static_cast<std::size_t>(c)] = frames[i].apply({s.xyz[0] + ((c & 1) ? 0.5 : -0.5) * s.size[0],
-                                                                s.xyz[1] + ((c & 2) ? 0.5 : -0.5) * s.size[1],
-                                                                s.xyz[2] - s.size[2] / 2});
-    soles.push_back(a);
+      corners.emplace_back(&s, frames[i].apply({s.xyz[0] + ((c & 1) ? 0.5 : -0.5) * s.size[0],
+                                                s.xyz[1] + ((c & 2) ? 0.5 : -0.5) * s.size[1], s.xyz[2] - s.size[2] / 2}));
   }
-  if (soles.empty()) {
-    b.margin = -std::numeric_limits<double>::infinity();
-    return b;
-  }
-  // The floor: the first sole no corner of another sole reaches below; else the root upright.
-  std::optional<frame> floor;
-  for (const auto& a : soles) {
-    bool lowest = true;
-    for (const auto& o : soles)
-      for (const auto& c : o.corners) lowest = lowest && detail::into(a.bottom, c)[2] >= -contact_mm;
-    if (lowest) {
-      floor = a.bottom;
-      b.standing_on = a.s->link;
-      break;
-    }
-  }
-  if (!floor) {
-    frame f;
-    f.p[2] = std::numeric_limits<double>::infinity();
-    for (const auto& a : soles)
-      for (const auto& c : a.corners) f.p[2] = std::min(f.p[2], c[2]);
-    floor = f;
-  }
-  b.com = detail::into(*floor, com);
-  b.tilt = std::acos(std::clamp(floor->r[8], -1.0, 1.0)) / detail::degrees;  // root z · floor normal
-  std::vector<point2> on_floor;
-  for (const auto& a : soles)
-    for (const auto& c : a.corners) {
-      const auto q = detail::into(*floor, c);
+  // The robot on the floor plane with normal n (pointing up) through the point on.
+  const vec3 up{0, 0, 1};  // the root's z axis
+  const auto resting_on = [&](const vec3& n, const vec3& on) {
+    balance r;
+    r.mass = b.mass;
+    // The floor's frame: its origin under the root's, x the root's forward along it, z its normal.
+    const vec3 origin{n[0] * dot(n, on), n[1] * dot(n, on), n[2] * dot(n, on)};
+    vec3 x = sub(vec3{1, 0, 0}, vec3{n[0] * n[0], n[0] * n[1], n[0] * n[2]});  // root x minus its normal part
+    if (dot(x, x) < 1e-12) x = crossv(vec3{0, 1, 0}, n);
+    const double xl = std::sqrt(dot(x, x));
+    for (auto& v : x) v /= xl;
+    const vec3 y = crossv(n, x);
+    const auto floor_of = [&](const vec3& p) {
+      const auto q = sub(p, origin);
+      return vec3{dot(x, q), dot(y, q), dot(n, q)};
+    };
+    r.com = floor_of(com);
+    r.tilt = std::acos(std::clamp(dot(n, up), -1.0, 1.0)) / detail::degrees;
+    r.lean_forward = std::atan2(dot(x, up), dot(n, up)) / detail::degrees;
+    r.lean_left = std::atan2(dot(y, up), dot(n, up)) / detail::degrees;
+    std::vector<point2> on_floor;
+    std::map<std::string, int> count;
+    for (const auto& [s, c] : corners) {
+      const auto q = floor_of(c);
       if (q[2] > contact_mm) continue;
       on_floor.push_back({q[0], q[1]});
-      if (std::find(b.touching.begin(), b.touching.end(), a.s->link) == b.touching.end())
-        b.touching.push_back(a.s->link);
+      if (count[s->link]++ == 0) r.touching.push_back(s->link);
     }
-  b.support = detail::hull(on_floor);
-  const point2 g{b.com[0], b.com[1]};
-  double dist = std::numeric_limits<double>::infinity();
-  bool inside = b.support.size() >= 3;
-  for (std::size_t i = 0; i < b.support.size(); ++i) {
-    const auto& p = b.support[i];
-    const auto& q = b.support[(i + 1) % b.support.size()];
-    inside = inside && detail::cross(p, q, g) > 0;
-    dist = std::min(dist, detail::to_segment(g, p, q));
+    for (const auto& t : r.touching)
+      if (r.standing_on.empty() || count[t] > count[r.standing_on]) r.standing_on = t;
+    r.support = detail::hull(on_floor);
+    const point2 g{r.com[0], r.com[1]};
+    double dist = std::numeric_limits<double>::infinity();
+    bool inside = r.support.size() >= 3;
+    for (std::size_t i = 0; i < r.support.size(); ++i) {
+      const auto& p = r.support[i];
+      const auto& q = r.support[(i + 1) % r.support.size()];
+      inside = inside && detail::cross(p, q, g) > 0;
+      dist = std::min(dist, detail::to_segment(g, p, q));
+    }
+    r.margin = inside ? dist : -dist;
+    return r;
+  };
+  // The floors it could rest on: planes through three corners with none below (faces of their
+  // convex hull), each with its tilt from upright.
+  struct face {
+    double tilt;
+    vec3 n, on;
+  };
+  std::vector<face> faces;
+  const double eps = 1e-6;
+  for (std::size_t i = 0; i < corners.size(); ++i)
+    for (std::size_t j = i + 1; j < corners.size(); ++j)
+      for (std::size_t m = j + 1; m < corners.size(); ++m) {
+        const auto& p = corners[i].second;
+        auto n = crossv(sub(corners[j].second, p), sub(corners[m].second, p));
+        const double len = std::sqrt(dot(n, n));
+        if (len < 1e-9) continue;  // three corners in a line
+        for (auto& v : n) v /= len;
+        bool above = true, below = true;
+        for (const auto& c : corners) {
+          const double h = dot(n, sub(c.second, p));
+          above = above && h >= -eps;
+          below = below && h <= eps;
+        }
+        if (!above && !below) continue;  // corners on both sides: not a face the robot rests on
+        // The normal points up, towards the corners; when they all lie in the plane (soles flat
+        // together), towards the body's centre of mass.
+        if (!above || (below && dot(n, sub(com, p)) < 0))
+          for (auto& v : n) v = -v;
+        faces.push_back({std::acos(std::clamp(dot(n, up), -1.0, 1.0)) / detail::degrees, n, p});
+      }
+  if (faces.empty()) {
+    b.margin = -std::numeric_limits<double>::infinity();  // no sole, or nothing to stand on
+    return b;
   }
-  b.margin = inside ? dist : -dist;
-  return b;
+  // Set down on the least tilted face. When its centre of mass is outside, it tips: onto the
+  // least tilted face within settle_deg more that holds it (a heel a few mm up), else it falls.
+  std::sort(faces.begin(), faces.end(), [](const face& a, const face& c) { return a.tilt < c.tilt; });
+  auto first = resting_on(faces.front().n, faces.front().on);
+  if (first.stable()) return first;
+  for (std::size_t i = 1; i < faces.size() && faces[i].tilt <= faces.front().tilt + settle_deg; ++i) {
+    auto r = resting_on(faces[i].n, faces[i].on);
+    if (r.stable()) return r;
+  }
+  return first;
 }
 
 /**

@@ -149,8 +149,48 @@ TEST_CASE("balance: the KHR-3HV in its home pose stands on both feet, hips pitch
   REQUIRE(pitched);
   CHECK(pitched->tilt == Approx(80).margin(0.5));
   CHECK_FALSE(pitched->stable());
+  // The torso's lean has a direction: both hips pitched the same way lean it along x only.
+  CHECK(std::abs(pitched->lean_forward) == Approx(80).margin(0.5));
+  CHECK(pitched->lean_left == Approx(0).margin(1e-6));
+  CHECK(home->com[1] == Approx(0).margin(0.5));  // the floor's origin is under the pelvis: y 0 when symmetric
   // One knee bent far: the robot stands on the other foot (the bent one's sole is lifted).
   const auto one = balance_of(m, {{"left_hip_pitch", -40}, {"left_knee", 80}, {"left_ankle_pitch", -40}});
   REQUIRE(one);
   CHECK(one->touching == std::vector<std::string>{"right_foot"});
+}
+
+TEST_CASE("balance: a lifted or tilted foot never becomes the floor the robot stands on", "[balance]") {
+  // A newcomer's trial: a knee bent far alone tilts its foot and lifts it; either knee, the
+  // robot stays upright on the other foot (and, its centre of mass between the feet, falls sideways).
+  const auto m = open_profile("khr-3hv");
+  for (const auto& [knee, other] : {std::pair{"left_knee", "right_foot"}, std::pair{"right_knee", "left_foot"}}) {
+    const auto b = balance_of(m, {{knee, 90.0}});
+    REQUIRE(b);
+    INFO(knee);
+    CHECK(b->touching == std::vector<std::string>{other});
+    CHECK(b->tilt == Approx(0).margin(0.01));
+    CHECK_FALSE(b->stable());
+    // Bent 20 degrees, the foot's tilted edge reaches below the other sole: the robot rests on both,
+    // a little tilted, never on the tilted sole alone.
+    const auto little = balance_of(m, {{knee, 20.0}});
+    REQUIRE(little);
+    CHECK(little->touching.size() == 2);
+    CHECK(little->tilt > 1);
+    CHECK(little->tilt < 15);
+  }
+  // Legs spread 10 degrees (the hip rolls, mirrored): the feet tilt outwards and the robot stands
+  // upright on their inner edges.
+  const auto spread = balance_of(m, {{"left_hip_roll", 10}, {"right_hip_roll", 10}});
+  REQUIRE(spread);
+  CHECK(spread->touching == std::vector<std::string>{"left_foot", "right_foot"});
+  CHECK(spread->tilt == Approx(0).margin(0.01));
+  CHECK(spread->stable());
+  // A lunge (one hip forward, the other back, the ankles keeping both feet flat): the rear foot's
+  // heel a few mm up, the robot tips a little onto both and stands.
+  const auto lunge = balance_of(m, {{"left_hip_pitch", -30}, {"right_hip_pitch", 30},
+                                    {"left_ankle_pitch", 30}, {"right_ankle_pitch", -30}});
+  REQUIRE(lunge);
+  CHECK(lunge->touching.size() == 2);
+  CHECK(lunge->tilt < 5);
+  CHECK(lunge->stable());
 }
