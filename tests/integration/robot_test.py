@@ -279,8 +279,16 @@ with serve() as dev:
     b = json.loads(out) if rc == 0 else {}
     check(rc == 0 and b.get("paced") is False and len(b.get("plan_reads", [])) <= 4,
           f"bench against an unpaced board: paced false, {len(b.get('plan_reads', []))} reads")
-    rc, out, err = run("--device", dev, "--baud", "1250000", "bench", "--count", "10")
-    check(rc == 0 and "warning: faster than 1250000 baud carries the bytes" in out, "and its text warns")
+    # The text run measures the link again: whether a board keeps the wire's pace is a timing, and
+    # on a loaded machine (sanitizers, CPU hogs) an unpaced pty's replies can come as slowly as the
+    # wire's once. The warning must show in one of three runs; each run's verdict is printed.
+    verdicts = []
+    for _ in range(3):
+        rc, out, err = run("--device", dev, "--baud", "1250000", "bench", "--count", "10")
+        verdicts.append("warned" if "warning: faster than 1250000 baud carries the bytes" in out else "paced")
+        if rc != 0 or verdicts[-1] == "warned":
+            break
+    check(rc == 0 and verdicts[-1] == "warned", f"and its text warns ({verdicts})")
 
 # The README's whole program, as a reader copies it, against the virtual robot.
 if README_JOINTS:
