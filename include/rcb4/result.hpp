@@ -128,6 +128,12 @@ template <class T>
 class [[nodiscard]] result {
   static_assert(!std::is_reference_v<T> && !std::is_same_v<std::remove_cv_t<T>, errc>,
                 "result<T> holds a value type other than errc");
+  // Which copies and moves stay trivial (T's are): the codec's commands keep a trivial result.
+  static constexpr bool trivial_copy = std::is_trivially_copy_constructible_v<T>;
+  static constexpr bool trivial_move = std::is_trivially_move_constructible_v<T>;
+  static constexpr bool trivial_end = std::is_trivially_destructible_v<T>;
+  static constexpr bool trivial_copy_assign = std::is_trivially_copy_assignable_v<T> && trivial_copy && trivial_end;
+  static constexpr bool trivial_move_assign = std::is_trivially_move_assignable_v<T> && trivial_move && trivial_end;
 
  public:
   using value_type = T;
@@ -142,41 +148,33 @@ class [[nodiscard]] result {
   }
 
   // Copies and moves: trivial where T's are (the codec's commands), else member-wise.
-  constexpr result(const result&) noexcept
-    requires std::is_trivially_copy_constructible_v<T>
-  = default;
+  constexpr result(const result&) noexcept requires trivial_copy = default;
   constexpr result(const result& o) noexcept : none_(), error_(o.error_) {
     if (has_value()) std::construct_at(&value_, o.value_);
   }
-  constexpr result(result&&) noexcept
-    requires std::is_trivially_move_constructible_v<T>
-  = default;
+  constexpr result(result&&) noexcept requires trivial_move = default;
   constexpr result(result&& o) noexcept : none_(), error_(o.error_) {
     if (has_value()) std::construct_at(&value_, std::move(o.value_));
   }
-  constexpr result& operator=(const result&) noexcept
-    requires(std::is_trivially_copy_assignable_v<T> && std::is_trivially_copy_constructible_v<T> &&
-             std::is_trivially_destructible_v<T>)
-  = default;
+  constexpr result& operator=(const result&) noexcept requires trivial_copy_assign = default;
   constexpr result& operator=(const result& o) noexcept {
     if (this == &o) return *this;
-    if (o.has_value()) assign_value(o.value_);
-    else assign_error(o.error_);
+    if (o.has_value())
+      assign_value(o.value_);
+    else
+      assign_error(o.error_);
     return *this;
   }
-  constexpr result& operator=(result&&) noexcept
-    requires(std::is_trivially_move_assignable_v<T> && std::is_trivially_move_constructible_v<T> &&
-             std::is_trivially_destructible_v<T>)
-  = default;
+  constexpr result& operator=(result&&) noexcept requires trivial_move_assign = default;
   constexpr result& operator=(result&& o) noexcept {
     if (this == &o) return *this;
-    if (o.has_value()) assign_value(std::move(o.value_));
-    else assign_error(o.error_);
+    if (o.has_value())
+      assign_value(std::move(o.value_));
+    else
+      assign_error(o.error_);
     return *this;
   }
-  constexpr ~result()
-    requires std::is_trivially_destructible_v<T>
-  = default;
+  constexpr ~result() requires trivial_end = default;
   constexpr ~result() {
     if (has_value()) value_.~T();
   }

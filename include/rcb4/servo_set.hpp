@@ -12,8 +12,8 @@
 
 #include <array>
 #include <bit>
-#include <cstdint>
 #include <cstddef>
+#include <cstdint>
 #include <initializer_list>
 #include <iterator>
 #include <span>
@@ -69,8 +69,8 @@ class servo_mask {
   /** Iterates the selected ICS numbers in ascending order. */
   class iterator {
    public:
-    using value_type = ics_number;             ///< what *it gives
-    using difference_type = std::ptrdiff_t;    ///< for std::ranges (a forward range)
+    using value_type = ics_number;                        ///< what *it gives
+    using difference_type = std::ptrdiff_t;               ///< for std::ranges (a forward range)
     using iterator_category = std::forward_iterator_tag;  ///< for the standard algorithms
     constexpr iterator() noexcept = default;
     constexpr explicit iterator(std::uint64_t rest) noexcept : rest_(rest) {}
@@ -176,8 +176,8 @@ class servo_set {
   /** Iterates entries in ascending ICS order. */
   class iterator {
    public:
-    using value_type = entry;                  ///< what *it gives (ICS number and value)
-    using difference_type = std::ptrdiff_t;    ///< for std::ranges (a forward range)
+    using value_type = entry;                             ///< what *it gives (ICS number and value)
+    using difference_type = std::ptrdiff_t;               ///< for std::ranges (a forward range)
     using iterator_category = std::forward_iterator_tag;  ///< for the standard algorithms
     constexpr iterator() noexcept = default;
     constexpr iterator(servo_mask::iterator m, const T* v) noexcept : m_(m), v_(v) {}

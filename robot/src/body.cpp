@@ -170,8 +170,7 @@ std::string to_urdf(const model& m, const urdf_options& o) {
       out += fmt::format(
           "    <inertial><origin xyz=\"{}\" rpy=\"0 0 0\"/><mass value=\"{:g}\"/>"
           "<inertia ixx=\"{:g}\" ixy=\"{:g}\" ixz=\"{:g}\" iyy=\"{:g}\" iyz=\"{:g}\" izz=\"{:g}\"/></inertial>\n",
-          metres(w.com), w.mass / 1000, i[0] * 1e-6, i[3] * 1e-6, i[4] * 1e-6, i[1] * 1e-6, i[5] * 1e-6,
-          i[2] * 1e-6);
+          metres(w.com), w.mass / 1000, i[0] * 1e-6, i[3] * 1e-6, i[4] * 1e-6, i[1] * 1e-6, i[5] * 1e-6, i[2] * 1e-6);
     }
     for (const auto& s : l.shapes)
       out += fmt::format(

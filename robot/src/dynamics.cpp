@@ -55,17 +55,21 @@ dynamics parse_dynamics(const std::string& source, const YAML::Node& n, const ki
     } else {
       l.whole = parse_part(source, kv.second, l.link);
     }
-    if (const auto problem = inertial_problem(l.whole)) fail(source, kv.first, l.link + ": its parts together: " + *problem);
+    if (const auto problem = inertial_problem(l.whole))
+      fail(source, kv.first, l.link + ": its parts together: " + *problem);
     d.links.push_back(std::move(l));
   }
   const auto ss = n["soles"];
   if (!ss || !ss.IsMap() || ss.size() == 0)
-    fail(source, ss ? ss : n, "dynamics: soles: the boxes the robot stands on are required, e.g. left_foot: {box: [x, y, z], xyz: [x, y, z]}");
+    fail(source, ss ? ss : n,
+         "dynamics: soles: the boxes the robot stands on are required, e.g. left_foot: {box: [x, y, z], xyz: [x, y, "
+         "z]}");
   for (const auto& kv : ss) {
     sole s;
     s.link = scalar(source, kv.first, "dynamics: sole");
     const auto& v = kv.second;
-    if (!body.find_link(s.link)) fail(source, kv.first, "soles: " + s.link + ": no link of the kinematics is called so");
+    if (!body.find_link(s.link))
+      fail(source, kv.first, "soles: " + s.link + ": no link of the kinematics is called so");
     if (!v.IsMap()) fail(source, v, "soles: " + s.link + ": expected {box: [x, y, z], xyz: [x, y, z], friction: mu}");
     check_keys(source, v, {"box", "xyz", "friction"}, "soles: " + s.link);
     s.size = three(source, v["box"], "soles: " + s.link + ": box");

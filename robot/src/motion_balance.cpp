@@ -9,11 +9,11 @@
 namespace rcb4::robot {
 
 motion_balance check_balance(const motion_document& d, const model& m) {
-  if (!m.body())
-    throw profile_error(m.name(), "the profile has no body (kinematics:), so no balance to check");
+  if (!m.body()) throw profile_error(m.name(), "the profile has no body (kinematics:), so no balance to check");
   if (!m.dynamics())
-    throw profile_error(m.name(), "the profile has no mass model (dynamics:), so no balance to check: "
-                                  "docs/robot-profiles.md shows how to add one");
+    throw profile_error(m.name(),
+                        "the profile has no mass model (dynamics:), so no balance to check: "
+                        "docs/robot-profiles.md shows how to add one");
   motion_balance out;
   out.mass = m.dynamics()->total_mass();
   std::map<std::string, double> angles;  // every profile joint, as the poses so far left it

@@ -32,21 +32,20 @@ static_assert(!std::is_default_constructible_v<const_servo> && !std::is_default_
               !std::is_default_constructible_v<ics::write_id> && !std::is_default_constructible_v<ics::set_position>);
 
 // Chaining: and_then passes the value on or keeps the first error; transform maps the value.
-static_assert(made(4).and_then([](const only_made& m) { return made(m.v - 10); }).error() ==
-              errc::param_out_of_range);
-static_assert(made(-4).and_then([](const only_made&) -> result<int> { return 1; }).error() ==
-              errc::param_out_of_range);
+static_assert(made(4).and_then([](const only_made& m) { return made(m.v - 10); }).error() == errc::param_out_of_range);
+static_assert(made(-4).and_then([](const only_made&) -> result<int> { return 1; }).error() == errc::param_out_of_range);
 static_assert(made(4).transform([](const only_made& m) { return m.v * 2; }).value() == 8);
 static_assert(made(-4).or_else([](errc) -> result<only_made> { return only_made(0); }).value().v == 0);
-static_assert(servo_position::make(7500).and_then([](servo_position p) { return servo_position::make(p.value() + 9000); })
+static_assert(servo_position::make(7500)
+                  .and_then([](servo_position p) { return servo_position::make(p.value() + 9000); })
                   .error() == errc::position_out_of_range);
 
 // A T that owns memory: copied, moved, reassigned between value and error (constexpr allocation).
 constexpr bool owning_round_trip() {
   result<std::vector<int>> a(std::vector<int>{1, 2, 3});
   result<std::vector<int>> b(errc::nack);
-  b = a;              // error -> value
-  a = errc::nack;     // value -> error
+  b = a;           // error -> value
+  a = errc::nack;  // value -> error
   if (a.has_value() || b.value().size() != 3) return false;
   result<std::vector<int>> c(std::move(b));
   b = result<std::vector<int>>(std::vector<int>{7});

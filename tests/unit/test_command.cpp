@@ -26,7 +26,7 @@ struct alternative_index<T, std::variant<Ts...>> {
     return i;
   }();
 };
-}
+}  // namespace
 
 TEMPLATE_LIST_TEST_CASE("every command round-trips: serialize, board-side parse, equal value", "[command]",
                         all_command_types) {

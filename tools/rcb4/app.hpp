@@ -286,19 +286,19 @@ const rcb4::rom_layout& layout_for(session& s, const motion_options& o);
 /** `motion play FILE`: a motion file played from the host, pose by pose with the board's timing (cmd_motion_files.cpp).
  */
 int play_file(session& s, const std::string& file, bool rescale, const motion_options& o, const globals& g);
-void add_bench_command(CLI::App& app, context& ctx);        ///< bench (cmd_bench.cpp)
-void add_host_commands(CLI::App& app, context& ctx);        ///< list, doctor (cmd_host.cpp)
-void add_frame_commands(CLI::App& app, context& ctx);       ///< decode, encode (cmd_frames.cpp)
-void add_serve_command(CLI::App& app, context& ctx);        ///< serve (cmd_serve.cpp)
-void add_robot_commands(CLI::App& app, context& ctx);       ///< joint, pose, trim, scan (cmd_robot.cpp)
-void add_ui_command(CLI::App& app, context& ctx);           ///< ui (cmd_ui.cpp, ui/)
-void add_rom_commands(CLI::App& app, context& ctx);         ///< rom backup|restore (cmd_rom.cpp)
-void add_urdf_command(CLI::App& app, context& ctx);         ///< urdf (cmd_urdf.cpp)
-void add_ics_commands(CLI::App& app, context& ctx);         ///< ics … (cmd_ics.cpp, cmd_ics_serve.cpp)
-void add_project_commands(CLI::App& app, context& ctx);     ///< project import|export (cmd_project.cpp)
-void add_trim_import(CLI::App* trim, context& ctx);         ///< trim import (cmd_project.cpp)
-void add_startup_command(CLI::App* motion, context& ctx);   ///< motion startup (cmd_startup.cpp)
-void add_flowchart_import(CLI::App* motion, context& ctx);  ///< motion import (cmd_project.cpp)
+void add_bench_command(CLI::App& app, context& ctx);            ///< bench (cmd_bench.cpp)
+void add_host_commands(CLI::App& app, context& ctx);            ///< list, doctor (cmd_host.cpp)
+void add_frame_commands(CLI::App& app, context& ctx);           ///< decode, encode (cmd_frames.cpp)
+void add_serve_command(CLI::App& app, context& ctx);            ///< serve (cmd_serve.cpp)
+void add_robot_commands(CLI::App& app, context& ctx);           ///< joint, pose, trim, scan (cmd_robot.cpp)
+void add_ui_command(CLI::App& app, context& ctx);               ///< ui (cmd_ui.cpp, ui/)
+void add_rom_commands(CLI::App& app, context& ctx);             ///< rom backup|restore (cmd_rom.cpp)
+void add_urdf_command(CLI::App& app, context& ctx);             ///< urdf (cmd_urdf.cpp)
+void add_ics_commands(CLI::App& app, context& ctx);             ///< ics … (cmd_ics.cpp, cmd_ics_serve.cpp)
+void add_project_commands(CLI::App& app, context& ctx);         ///< project import|export (cmd_project.cpp)
+void add_trim_import(CLI::App* trim, context& ctx);             ///< trim import (cmd_project.cpp)
+void add_startup_command(CLI::App* motion, context& ctx);       ///< motion startup (cmd_startup.cpp)
+void add_flowchart_import(CLI::App* motion, context& ctx);      ///< motion import (cmd_project.cpp)
 void add_motion_check_command(CLI::App* motion, context& ctx);  ///< motion check (cmd_motion_check.cpp)
 // Shared by the robot commands (cmd_robot.cpp) and motion record (cmd_record.cpp).
 /** Reads stdin up to a newline: true when Enter came; false at its end or on a caught signal. */

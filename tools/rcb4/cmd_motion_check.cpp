@@ -47,7 +47,8 @@ std::string lean_text(const ro::balance& b) {
   if (std::abs(b.lean_forward) >= 0.05)
     out = fmt::format("{:.1f}° {}", std::abs(b.lean_forward), b.lean_forward > 0 ? "forward" : "back");
   if (std::abs(b.lean_left) >= 0.05)
-    out += fmt::format("{}{:.1f}° {}", out.empty() ? "" : ", ", std::abs(b.lean_left), b.lean_left > 0 ? "left" : "right");
+    out +=
+        fmt::format("{}{:.1f}° {}", out.empty() ? "" : ", ", std::abs(b.lean_left), b.lean_left > 0 ? "left" : "right");
   return out.empty() ? "upright" : out;
 }
 
@@ -56,16 +57,17 @@ int report(const ro::motion_balance& r, const std::string& what, const ro::model
   if (g.json) {
     json poses = json::array();
     for (const auto& p : r.poses)
-      poses.push_back({{"step", p.step + 1},
-                       {"name", p.name.empty() ? json(nullptr) : json(p.name)},
-                       {"margin_mm", std::round(p.at.margin * 10) / 10},
-                       {"stable", p.at.stable()},
-                       {"tilt_deg", std::round(p.at.tilt * 10) / 10},
-                       {"lean_forward_deg", std::round(p.at.lean_forward * 10) / 10},
-                       {"lean_left_deg", std::round(p.at.lean_left * 10) / 10},
-                       {"com_mm", {std::round(p.at.com[0] * 10) / 10, std::round(p.at.com[1] * 10) / 10,
-                                   std::round(p.at.com[2] * 10) / 10}},
-                       {"touching", p.at.touching}});
+      poses.push_back(
+          {{"step", p.step + 1},
+           {"name", p.name.empty() ? json(nullptr) : json(p.name)},
+           {"margin_mm", std::round(p.at.margin * 10) / 10},
+           {"stable", p.at.stable()},
+           {"tilt_deg", std::round(p.at.tilt * 10) / 10},
+           {"lean_forward_deg", std::round(p.at.lean_forward * 10) / 10},
+           {"lean_left_deg", std::round(p.at.lean_left * 10) / 10},
+           {"com_mm",
+            {std::round(p.at.com[0] * 10) / 10, std::round(p.at.com[1] * 10) / 10, std::round(p.at.com[2] * 10) / 10}},
+           {"touching", p.at.touching}});
     emit(json{{"motion", what},
               {"robot", robot.name()},
               {"mass_g", std::round(r.mass)},
@@ -116,9 +118,10 @@ void add_motion_check_command(CLI::App* motion, context& ctx) {
       throw usage_error(fmt::format("N: {} is not a motion's number (1..120)", o->what));
     const auto& robot = robot_of(ctx.g);
     if (!robot.dynamics())
-      throw usage_error(fmt::format("the profile of {} has no mass model (dynamics:): nothing to check balance with "
-                                    "(docs/robot-profiles.md shows how to add one)",
-                                    robot.name()));
+      throw usage_error(
+          fmt::format("the profile of {} has no mass model (dynamics:): nothing to check balance with "
+                      "(docs/robot-profiles.md shows how to add one)",
+                      robot.name()));
     if (!n) {
       ctx.action = [&ctx, o] {
         const auto& r = robot_of(ctx.g);

@@ -51,7 +51,8 @@ inline std::optional<std::size_t> plan_parts(std::span<byte_range> wanted, std::
                                              std::span<byte_range> out) noexcept {
   // Insertion sort: a few dozen ranges, no recursion (a firmware's worst stack stays a number).
   for (std::size_t i = 1; i < wanted.size(); ++i)
-    for (std::size_t j = i; j > 0 && wanted[j].address < wanted[j - 1].address; --j) std::swap(wanted[j], wanted[j - 1]);
+    for (std::size_t j = i; j > 0 && wanted[j].address < wanted[j - 1].address; --j)
+      std::swap(wanted[j], wanted[j - 1]);
   std::size_t n = 0;
   bool overflow = false;
   const auto emit = [&](byte_range x) {

@@ -176,9 +176,9 @@ class table_then_reads {
     if (error_ != errc{}) return std::nullopt;
     if (!table_read_) return read_allocation();
     if (step_ >= plan_.size()) return std::nullopt;
-    return command{move::read_ram(ram_address::make(plan_[step_].address).value(),
-                                  transfer_size::make(plan_[step_].size).value())
-                       .value()};
+    return command{
+        move::read_ram(ram_address::make(plan_[step_].address).value(), transfer_size::make(plan_[step_].size).value())
+            .value()};
   }
   /** Takes a reply; true when the last read is in (slots() and word() are then ready). */
   bool on_reply(const reply& r) {

@@ -43,7 +43,8 @@ struct frame {
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j) {
         double s = 0;
-        for (int k = 0; k < 3; ++k) s += r[static_cast<std::size_t>(3 * i + k)] * b.r[static_cast<std::size_t>(3 * k + j)];
+        for (int k = 0; k < 3; ++k)
+          s += r[static_cast<std::size_t>(3 * i + k)] * b.r[static_cast<std::size_t>(3 * k + j)];
         out.r[static_cast<std::size_t>(3 * i + j)] = s;
       }
     out.p = apply(b.p);
@@ -60,9 +61,15 @@ inline frame from_rpy(const vec3& xyz, const vec3& rpy) noexcept {
   const double cp = std::cos(rpy[1] * degrees), sp = std::sin(rpy[1] * degrees);
   const double cy = std::cos(rpy[2] * degrees), sy = std::sin(rpy[2] * degrees);
   frame f;
-  f.r = {cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,  //
-         sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,  //
-         -sp,     cp * sr,                cp * cr};
+  f.r = {cy * cp,
+         cy * sp * sr - sy * cr,
+         cy * sp * cr + sy * sr,  //
+         sy * cp,
+         sy * sp * sr + cy * cr,
+         sy * sp * cr - cy * sr,  //
+         -sp,
+         cp * sr,
+         cp * cr};
   f.p = xyz;
   return f;
 }
@@ -209,8 +216,9 @@ inline balance balance_of(const kinematics& k, const dynamics& d, const std::map
     const auto i = index_of(s.link);
     if (i >= frames.size()) continue;
     for (int c = 0; c < 4; ++c)
-      corners.emplace_back(&s, frames[i].apply({s.xyz[0] + ((c & 1) ? 0.5 : -0.5) * s.size[0],
-                                                s.xyz[1] + ((c & 2) ? 0.5 : -0.5) * s.size[1], s.xyz[2] - s.size[2] / 2}));
+      corners.emplace_back(&s,
+                           frames[i].apply({s.xyz[0] + ((c & 1) ? 0.5 : -0.5) * s.size[0],
+                                            s.xyz[1] + ((c & 2) ? 0.5 : -0.5) * s.size[1], s.xyz[2] - s.size[2] / 2}));
   }
   // The robot on the floor plane with normal n (pointing up) through the point on.
   const vec3 up{0, 0, 1};  // the root's z axis

@@ -26,8 +26,8 @@ using inertia6 = std::array<double, 6>;
 
 /** A rigid part's mass properties in its link's frame. */
 struct inertial {
-  double mass = 0;   ///< grams
-  vec3 com{};        ///< centre of mass, mm
+  double mass = 0;     ///< grams
+  vec3 com{};          ///< centre of mass, mm
   inertia6 inertia{};  ///< about com, link axes, kg·mm²
 };
 
@@ -48,8 +48,8 @@ struct joint_damping {
 
 /** A link's parts, combined into one inertial when read. */
 struct link_mass {
-  std::string link;  ///< the kinematics' link
-  inertial whole;    ///< its parts combined
+  std::string link;       ///< the kinematics' link
+  inertial whole;         ///< its parts combined
   std::size_t parts = 1;  ///< how many parts the profile gave
 };
 
@@ -112,8 +112,8 @@ inline std::optional<std::string> inertial_problem(const inertial& p) {
   // Sylvester: the leading minors of [[ixx ixy ixz][ixy iyy iyz][ixz iyz izz]] all positive.
   const double m1 = i[0];
   const double m2 = i[0] * i[1] - i[3] * i[3];
-  const double m3 = i[0] * (i[1] * i[2] - i[5] * i[5]) - i[3] * (i[3] * i[2] - i[5] * i[4]) +
-                    i[4] * (i[3] * i[5] - i[1] * i[4]);
+  const double m3 =
+      i[0] * (i[1] * i[2] - i[5] * i[5]) - i[3] * (i[3] * i[2] - i[5] * i[4]) + i[4] * (i[3] * i[5] - i[1] * i[4]);
   if (!(m1 > 0 && m2 > 0 && m3 > 0)) return "an inertia that is not positive definite";
   const double slack = 1e-9 * (i[0] + i[1] + i[2]);
   if (i[0] + i[1] + slack < i[2] || i[1] + i[2] + slack < i[0] || i[0] + i[2] + slack < i[1])

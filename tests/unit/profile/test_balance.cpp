@@ -44,7 +44,8 @@ TEST_CASE("dynamics: two parts combine by the parallel-axis theorem", "[profile]
   CHECK(c.inertia[1] == Approx(22));
   CHECK(c.inertia[2] == Approx(22));
   // Off the axes the products of inertia appear: d = (10, 10, 0) for a part of 100 g and its twin.
-  const auto d = combine(inertial{100, {10, 10, 0}, {1, 1, 1, 0, 0, 0}}, inertial{100, {-10, -10, 0}, {1, 1, 1, 0, 0, 0}});
+  const auto d =
+      combine(inertial{100, {10, 10, 0}, {1, 1, 1, 0, 0, 0}}, inertial{100, {-10, -10, 0}, {1, 1, 1, 0, 0, 0}});
   CHECK(d.inertia[3] == Approx(-2 * 0.1 * 100));  // ixy = -sum m x y
   CHECK(d.inertia[2] == Approx(2 + 2 * 0.1 * 200));
 }
@@ -79,15 +80,15 @@ TEST_CASE("dynamics: each mistake with its line", "[profile][dynamics]") {
                            "    leg: {mass: 100, com: [0, 0, -5], inertia: [30, 80, 100]}\n" +
                            ok_soles;
   CHECK_NOTHROW(parse_profile(good, "good.yaml"));
-  CHECK_THAT(error_of(body + "dynamics:\n  links:\n    body: {mass: -5, com: [0, 0, 0], inertia: [1, 1, 1]}\n" +
-                      ok_soles),
-             Contains(":12:") && Contains("body: a mass must be more than 0 g"));
-  CHECK_THAT(error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 9]}\n" +
-                      ok_soles),
-             Contains(":12:") && Contains("triangle inequality"));
-  CHECK_THAT(error_of(body + "dynamics:\n  links:\n    arm: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n" +
-                      ok_soles),
-             Contains(":12:5") && Contains("arm: no link of the kinematics is called so"));
+  CHECK_THAT(
+      error_of(body + "dynamics:\n  links:\n    body: {mass: -5, com: [0, 0, 0], inertia: [1, 1, 1]}\n" + ok_soles),
+      Contains(":12:") && Contains("body: a mass must be more than 0 g"));
+  CHECK_THAT(
+      error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 9]}\n" + ok_soles),
+      Contains(":12:") && Contains("triangle inequality"));
+  CHECK_THAT(
+      error_of(body + "dynamics:\n  links:\n    arm: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n" + ok_soles),
+      Contains(":12:5") && Contains("arm: no link of the kinematics is called so"));
   CHECK_THAT(error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n"),
              Contains("soles") && Contains("required"));
   CHECK_THAT(error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n"
@@ -187,8 +188,8 @@ TEST_CASE("balance: a lifted or tilted foot never becomes the floor the robot st
   CHECK(spread->stable());
   // A lunge (one hip forward, the other back, the ankles keeping both feet flat): the rear foot's
   // heel a few mm up, the robot tips a little onto both and stands.
-  const auto lunge = balance_of(m, {{"left_hip_pitch", -30}, {"right_hip_pitch", 30},
-                                    {"left_ankle_pitch", 30}, {"right_ankle_pitch", -30}});
+  const auto lunge = balance_of(
+      m, {{"left_hip_pitch", -30}, {"right_hip_pitch", 30}, {"left_ankle_pitch", 30}, {"right_ankle_pitch", -30}});
   REQUIRE(lunge);
   CHECK(lunge->touching.size() == 2);
   CHECK(lunge->tilt < 5);

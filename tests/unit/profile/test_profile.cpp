@@ -87,7 +87,8 @@ TEST_CASE("profile: a bad profile names the file, the line and what is wrong", "
   CHECK(error_of(base + "motions:\n  0: stand\n") ==
         "bad.yaml:5:3: motion slot: expected a whole number in 1..120, not 0");
   CHECK(error_of(base + "colour: red\n") ==
-        "bad.yaml:4:1: profile: unknown key 'colour' (known: robot, joints, groups, motions, mimic, kinematics, dynamics)");
+        "bad.yaml:4:1: profile: unknown key 'colour' (known: robot, joints, groups, motions, mimic, kinematics, "
+        "dynamics)");
   CHECK(error_of(base + "  a: {ics: 2, lower: -10, upper: 10}\n") == "bad.yaml:4:3: joint 'a' is given twice");
   CHECK(error_of("robot: t\njoints: [\n").find("bad.yaml:") == 0);  // YAML syntax: yaml-cpp's words, with the place
   CHECK(error_of("robot: t\n") == "bad.yaml:1:1: joints: expected a mapping of joint names");

@@ -25,9 +25,9 @@ struct pose_balance {
 
 /** A motion's poses checked for balance. */
 struct motion_balance {
-  std::vector<pose_balance> poses;    ///< every pose step, in file order
-  std::vector<std::string> assumed;   ///< joints no pose names before the first that is checked: at 0
-  double mass = 0;                    ///< the robot's mass, grams
+  std::vector<pose_balance> poses;   ///< every pose step, in file order
+  std::vector<std::string> assumed;  ///< joints no pose names before the first that is checked: at 0
+  double mass = 0;                   ///< the robot's mass, grams
   /** The pose with the smallest margin, or nullptr when there is none. */
   const pose_balance* worst() const noexcept {
     const pose_balance* w = nullptr;
