@@ -1,4 +1,4 @@
-# Writes a C++ source holding files as byte arrays: the rcb4 ui page (tools/rcb4/ui/page).
+# Writes a C++ source holding files as byte arrays: the rcb4 ui page (studio/page).
 # cmake -DOUTPUT=page_files.cpp "-DFILES=/|text/html|index.html;/app.js|text/javascript|app.js" -DDIR=page -P embed_files.cmake
 set(body "// Generated from ${DIR} by cmake/embed_files.cmake: do not edit.\n#include \"server.hpp\"\n\nnamespace cli::ui {\nnamespace {\n")
 set(table "")

@@ -1,4 +1,4 @@
-// libFuzzer harness: rcb4 ui's page messages (tools/rcb4/ui: parse_message and the controller).
+// libFuzzer harness: rcb4 ui's page messages (studio/policy: parse_message and the controller).
 // The input is split at newlines into messages from two pages (even lines: page 1, which
 // controls first; odd: page 2, which watches until it takes control), each 10 ms after the last.
 // Properties:

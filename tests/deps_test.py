@@ -131,7 +131,7 @@ def eslint_modules():
     hook.close()
     args = lint_command()
     env = dict(os.environ, NODE_PATH="/usr/share/nodejs", NODE_OPTIONS=f"--require {hook.name}")
-    p = subprocess.run(args, cwd=os.path.join(SRC, "tools/rcb4/ui/page"), capture_output=True, text=True,
+    p = subprocess.run(args, cwd=os.path.join(SRC, "studio/page"), capture_output=True, text=True,
                        env=env, timeout=120)
     loaded = [line for line in open(out.name).read().splitlines() if line and line != hook.name]
     os.unlink(hook.name)

@@ -1,21 +1,11 @@
-// rcb4 command-line tool: ui (the robot in a browser: joints, poses, motions, sensors, link).
+// rcb4 command-line tool: ui, the front of the studio (studio/): the options read and checked,
+// the device opened; studio/server/studio.hpp serves the robot in a browser.
 // SPDX-License-Identifier: BSL-1.0
 #include "app.hpp"
-#include "ui/board_loop.hpp"
-#include "ui/server.hpp"
+#include "studio.hpp"  // studio/server: the studio this command fronts
 
-#include <rcb4/transport/share.hpp>
-
-#include <boost/asio/ip/host_name.hpp>
-#include <boost/asio/signal_set.hpp>
-
-#include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <random>
-#include <sstream>
-#include <thread>
 
 namespace cli {
 namespace {
@@ -51,20 +41,6 @@ std::string new_token() {
   return out;
 }
 
-std::string url_of(const boost::asio::ip::tcp::endpoint& ep, const std::string& token) {
-  std::string host;
-  if (ep.address().is_unspecified()) {
-    boost::system::error_code ec;
-    host = boost::asio::ip::host_name(ec);
-    if (ec || host.empty()) host = "HOST";
-  } else if (ep.address().is_v6()) {
-    host = "[" + ep.address().to_string() + "]";
-  } else {
-    host = ep.address().to_string();
-  }
-  return fmt::format("http://{}:{}/{}", host, ep.port(), token.empty() ? "" : "?token=" + token);
-}
-
 int run_ui(context& ctx, const ui_options& o, bool token_given) {
   // NaN passes a range check (every comparison is false): it would switch the speed limit off.
   if (!(o.speed >= 1 && o.speed <= 1000)) throw usage_error("--speed: degrees per second, 1 to 1000");
@@ -85,34 +61,8 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
     if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_')
       throw usage_error("--token: use letters, digits, - and _ (it goes in a URL and a cookie)");
 
-  // three.js for the 3D view, served from Debian's copy (libjs-three) as Debian wants JavaScript
-  // libraries shared, not embedded: read once here, so nothing is read from disk while serving.
-  for (const auto& [url, file] :
-       {std::pair{"/vendor/three/build/three.module.js", "build/three.module.js"},
-        std::pair{"/vendor/three/examples/jsm/controls/OrbitControls.js", "examples/jsm/controls/OrbitControls.js"}}) {
-    std::ifstream in(std::filesystem::path(o.three) / file, std::ios::binary);
-    if (!in) {
-      fmt::print(stderr, "rcb4 ui: no {} in {} (apt install libjs-three): the page works without its 3D view\n", file,
-                 o.three);
-      so.vendor.clear();
-      break;
-    }
-    std::ostringstream body;
-    body << in.rdbuf();
-    so.vendor.push_back({url, "text/javascript; charset=utf-8", body.str()});
-  }
-
-  boost::asio::io_context io;
-  std::optional<ui::web_server> server;
-  try {
-    server.emplace(io, so);
-  } catch (const boost::system::system_error& e) {
-    throw failure(exit_io, fmt::format("cannot listen on {}: {}", o.listen, e.code().message()),
-                  e.code() == boost::asio::error::address_in_use
-                      ? "another program has that port: --listen 127.0.0.1:0 "
-                        "picks a free one"
-                      : "");
-  }
+  so.vendor = ui::three_js_files(o.three);
+  ui::studio studio(std::move(so));  // listening before the board is opened: a port in use fails first
 
   session s(ctx.g);  // the device (or the in-process virtual robot): its failures exit 1/3/4 as everywhere
   if (s.shared())
@@ -121,7 +71,6 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
 
   ui::settings limits;
   limits.max_speed = o.speed;
-  ui::hub h(m, limits, [&server](ui::client_id to, std::string text) { server->send(to, std::move(text)); });
   ui::loop_options lo;
   lo.poses = o.poses;
   try {
@@ -131,77 +80,7 @@ int run_ui(context& ctx, const ui_options& o, bool token_given) {
     fmt::print(stderr, "rcb4 ui: {}; motions are played as HTH4 2.2+ (--layout names another)\n", f.what());
     lo.layout = &rcb4::hth4_2_2;
   }
-  lo.device = s.where();
-  h.set_hello(ui::hello_text(m, s, lo, limits));
-
-  // The command line next to the studio: the port this studio holds is served to the user's other
-  // programs (rcb4 --device PORT, pyrcb4), through the session's client and its one FIFO
-  // (transport/share.hpp). The board loop re-reads what they may have changed.
-  auto outside_writes = std::make_shared<std::atomic<std::uint64_t>>(0);  // the client's thread may outlive this frame
-  std::shared_ptr<rcb4::transport::share_server<client>> share;
-  if (s.holds_port()) {
-    rcb4::transport::error_code ec;
-    share = rcb4::transport::share_server<client>::start(
-        io, s.c(), ctx.g.device,
-        [outside_writes](const rcb4::command& c, const rcb4::transport::error_code&, const rcb4::transport::response&) {
-          if (!rcb4::transport::is_idempotent(c)) ++*outside_writes;
-        },
-        ec);
-    if (ec)
-      fmt::print(stderr, "rcb4 ui: cannot share {} with other programs ({}): they will find it busy\n", s.where(),
-                 ec.message());
-    lo.outside_writes = outside_writes.get();
-  }
-  struct share_stopper {
-    std::shared_ptr<rcb4::transport::share_server<client>>& s;
-    ~share_stopper() {
-      if (s) s->stop();
-    }
-  } stop_share{share};
-
-  // The first line of stdout is the URL (scripts read it); the rest goes to stderr.
-  fmt::print("{}\n", url_of(server->local(), so.token));
-  std::fflush(stdout);
-  fmt::print(stderr, "rcb4 ui: {} on {}; poses in {}; Ctrl-C stops\n", m.name(), s.where(), o.poses);
-  if (share)
-    fmt::print(stderr, "rcb4 ui: `rcb4 --device {}` and pyrcb4 reach the board through this studio\n", ctx.g.device);
-
-  boost::asio::signal_set signals(io, SIGINT, SIGTERM);
-  std::string loop_failure;
-  std::thread loop([&] {
-    try {
-      ui::run_board_loop(s, m, h, lo);
-    } catch (const std::exception& e) {
-      loop_failure = e.what();
-      boost::asio::post(io, [&] {
-        signals.cancel();
-        server->stop();
-        if (share) share->stop();
-      });
-    }
-  });
-  // Whatever happens next, the loop thread ends before what it uses goes.
-  struct joiner {
-    ui::hub& h;
-    std::thread& t;
-    ~joiner() {
-      h.stop();
-      if (t.joinable()) t.join();
-    }
-  } join_loop{h, loop};
-  signals.async_wait([&](const boost::system::error_code& ec, int) {
-    if (ec) return;
-    h.stop();  // the loop ends after the exchange under way; joined once io.run() returns
-    server->stop();
-    if (share) share->stop();  // its acceptor would keep io.run() going
-  });
-  server->start(h);
-  io.run();
-  h.stop();
-  loop.join();
-  if (!loop_failure.empty()) throw failure(exit_board, "the board loop stopped: " + loop_failure);
-  fmt::print(stderr, "rcb4 ui: stopped\n");
-  return exit_ok;
+  return studio.run(s, m, limits, std::move(lo), ctx.g.device);
 }
 
 }  // namespace

@@ -55,21 +55,12 @@ struct frame {
 namespace detail {
 constexpr double degrees = std::numbers::pi / 180;
 
-/** URDF's rpy (degrees): roll about x, then pitch about y, then yaw about z, fixed axes. */
+/** A joint's origin (URDF's xyz in mm, rpy in degrees) as a frame. */
 inline frame from_rpy(const vec3& xyz, const vec3& rpy) noexcept {
-  const double cr = std::cos(rpy[0] * degrees), sr = std::sin(rpy[0] * degrees);
-  const double cp = std::cos(rpy[1] * degrees), sp = std::sin(rpy[1] * degrees);
-  const double cy = std::cos(rpy[2] * degrees), sy = std::sin(rpy[2] * degrees);
+  const mat3 m = rpy_matrix(rpy);
   frame f;
-  f.r = {cy * cp,
-         cy * sp * sr - sy * cr,
-         cy * sp * cr + sy * sr,  //
-         sy * cp,
-         sy * sp * sr + cy * cr,
-         sy * sp * cr - cy * sr,  //
-         -sp,
-         cp * sr,
-         cp * cr};
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t j = 0; j < 3; ++j) f.r[3 * i + j] = m[i][j];
   f.p = xyz;
   return f;
 }

@@ -18,6 +18,21 @@ namespace rcb4::robot {
 
 /** Three numbers: a position in mm, angles in degrees, an axis, or a shape's size. */
 using vec3 = std::array<double, 3>;
+/** A rotation, row by row. */
+using mat3 = std::array<vec3, 3>;
+
+/**
+ * The rotation URDF's rpy (degrees) names: roll about x, then pitch about y, then yaw about z,
+ * about fixed axes, R = Rz(yaw) · Ry(pitch) · Rx(roll). The mirror and the balance check share it.
+ */
+inline mat3 rpy_matrix(const vec3& rpy_deg) noexcept {
+  constexpr double rad = 3.14159265358979323846 / 180.0;
+  const double cr = std::cos(rpy_deg[0] * rad), sr = std::sin(rpy_deg[0] * rad);
+  const double cp = std::cos(rpy_deg[1] * rad), sp = std::sin(rpy_deg[1] * rad);
+  const double cy = std::cos(rpy_deg[2] * rad), sy = std::sin(rpy_deg[2] * rad);
+  return {vec3{cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr},
+          vec3{sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr}, vec3{-sp, cp * sr, cp * cr}};
+}
 
 /** A simple solid that draws part of a link. */
 struct shape {

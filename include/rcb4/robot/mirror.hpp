@@ -33,17 +33,6 @@ struct mirror_image {
 };
 
 namespace detail {
-using mat3 = std::array<vec3, 3>;
-
-inline mat3 rpy_matrix(const vec3& rpy_deg) {
-  constexpr double rad = 3.14159265358979323846 / 180.0;
-  const double cr = std::cos(rpy_deg[0] * rad), sr = std::sin(rpy_deg[0] * rad);
-  const double cp = std::cos(rpy_deg[1] * rad), sp = std::sin(rpy_deg[1] * rad);
-  const double cy = std::cos(rpy_deg[2] * rad), sy = std::sin(rpy_deg[2] * rad);
-  // R = Rz(yaw) · Ry(pitch) · Rx(roll) (URDF's fixed-axis roll, pitch, yaw)
-  return {vec3{cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr},
-          vec3{sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr}, vec3{-sp, cp * sr, cp * cr}};
-}
 inline vec3 times(const mat3& m, const vec3& v) {
   return {m[0][0] * v[0] + m[0][1] * v[1] + m[0][2] * v[2], m[1][0] * v[0] + m[1][1] * v[1] + m[1][2] * v[2],
           m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};

@@ -3,7 +3,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
-#include "../app.hpp"
+#include "app.hpp"
 #include "hub.hpp"
 
 #include <atomic>

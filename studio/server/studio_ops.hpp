@@ -5,7 +5,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
-#include "../app.hpp"
+#include "app.hpp"
 #include "board_loop.hpp"
 #include "controller.hpp"
 

@@ -1,6 +1,6 @@
 // rcb4 ui: the page's entry (an ES module): the connection, the joints, poses, sensors, and the
 // studio's parts (view3d.js, editor.js, tables.js). One WebSocket to the server that owns the
-// board; nothing else is reached. Messages: tools/rcb4/ui/messages.hpp (to the server),
+// board; nothing else is reached. Messages: studio/policy/messages.hpp (to the server),
 // board_loop.cpp, controller.cpp and studio_ops.cpp (from it).
 import { $, el, breakable, fmtDeg, numberIn } from './dom.js';
 import { createView } from './view3d.js';
