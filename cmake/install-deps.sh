@@ -21,6 +21,7 @@ packages=(
   python3                              # a client in another language for the virtual board tests
   python3-venv python3-setuptools      # python.pip_install: pip in a venv builds pyrcb4 with Debian's setuptools
   ser2net                              # TCP bridge used by the transport tests
+  libftdi1-dev                         # rcb4/link/libftdi_device.hpp: an FTDI adapter through libusb, no tty (examples/ftdi_ping)
   doxygen                              # API documentation (the docs.doxygen test)
   chromium chromium-driver python3-selenium  # rcb4 ui's tests in a real (headless) browser
   eslint                               # the page's JavaScript linted in the suite (lint.studio_js)

@@ -1,22 +1,24 @@
 // Your own transport: rcb4's operations driven by nothing but POSIX read/write/poll on a file
-// descriptor, and the same loop over an in-memory link (a test double for your own tests).
+// descriptor, and the same loop over an in-memory link (a test double for your own tests). The
+// link's policy (deadlines, resync after an error, retries for reads, a write sent once, a
+// loopback named) is not written here: rcb4/link/device_link.hpp runs the library's public
+// exchange machine over any device that can write and read bytes without waiting.
 //
 //   rcb4_own_loop /dev/ttyUSB0     a board at 115200 baud (8E1), or a pty from `rcb4 serve --pty`
-//   rcb4_own_loop --memory         the virtual board in memory: no device, no thread, no clock
+//   rcb4_own_loop --memory         the virtual board in memory: no device, no thread
 //
 // It reads the config word and every servo's state (ops::read_config, ops::read_servo_states).
 // Exit status: 0 done; 1 the board refused (NACK) or its answers stayed malformed; 2 usage;
-// 3 an I/O error (no such device, not a terminal); 4 the board was silent past the deadline.
+// 3 an I/O error (no such device, not a terminal, unplugged); 4 the board was silent past the
+// deadlines.
 //
-// The contract (see the README, "Your own transport"):
-//   - op.next() gives the command to send, or nothing when the operation is finished;
-//   - send its frame, read one reply, and give it to op.on_reply(); then ask next() again;
-//   - op.error() is errc{} on success, errc::nack when the board refused, or what was wrong.
-// Framing: every reply starts with its length byte; rcb4::parse_reply() says how many bytes are
-// still needed, so the reader never reads into the next frame. Deadlines are yours: every wait
-// here is a poll() with what is left of a deadline.
+// What a device gives the link (see device_link.hpp): write() and read() that never wait (bytes
+// taken or read, 0 for none now, negative when the device failed), and optionally idle(until),
+// which waits for input until a deadline (here: poll()).
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/board/virtual_board.hpp>
+#include <rcb4/link/device_link.hpp>
+#include <rcb4/link/requests.hpp>
 #include <rcb4/ops/servos.hpp>
 #include <rcb4/ops/system.hpp>
 
@@ -25,29 +27,24 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include <array>
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <optional>
 #include <span>
 #include <string>
-#include <variant>
 #include <vector>
 
 namespace {
 
 using clock_type = std::chrono::steady_clock;
 
-/** How an exchange ended when no reply came: the board was silent, or the descriptor failed. */
-enum class link_status { ok, silent, io_error, malformed };
-
-/** A serial line (or pty) as a file descriptor: raw, 8 data bits, even parity, 1 stop bit. */
-class fd_link {
+/** A serial line (or pty) as a non-blocking file descriptor: raw, 8 data bits, even parity, 1 stop bit. */
+class fd_device {
  public:
   /** Opens @p path; fd() is -1 and why() says why when that failed. */
-  explicit fd_link(const char* path) : fd_(::open(path, O_RDWR | O_NOCTTY | O_CLOEXEC)) {
+  explicit fd_device(const char* path) : fd_(::open(path, O_RDWR | O_NOCTTY | O_CLOEXEC | O_NONBLOCK)) {
     if (fd_ < 0) {
       why_ = std::strerror(errno);
       return;
@@ -65,9 +62,9 @@ class fd_link {
     ::cfsetspeed(&t, B115200);
     ::tcsetattr(fd_, TCSANOW, &t);
   }
-  fd_link(const fd_link&) = delete;
-  fd_link& operator=(const fd_link&) = delete;
-  ~fd_link() {
+  fd_device(const fd_device&) = delete;
+  fd_device& operator=(const fd_device&) = delete;
+  ~fd_device() {
     if (fd_ >= 0) ::close(fd_);
   }
   /** The descriptor, or -1. */
@@ -75,41 +72,30 @@ class fd_link {
   /** Why opening failed. */
   const std::string& why() const noexcept { return why_; }
 
-  /** Writes all of @p bytes. */
-  link_status send(std::span<const std::uint8_t> bytes) {
-    ::tcflush(fd_, TCIFLUSH);  // a late reply to an earlier, abandoned exchange is not this one's
-    while (!bytes.empty()) {
-      const auto n = ::write(fd_, bytes.data(), bytes.size());
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) return link_status::io_error;
-      bytes = bytes.subspan(static_cast<std::size_t>(n));
+  /** Bytes of @p out the line took now; -1: it failed. */
+  long write(std::span<const std::uint8_t> out) {
+    for (;;) {
+      const auto n = ::write(fd_, out.data(), out.size());
+      if (n >= 0) return static_cast<long>(n);
+      if (errno == EINTR) continue;
+      return errno == EAGAIN || errno == EWOULDBLOCK ? 0 : -1;
     }
-    return link_status::ok;
   }
-  /** Reads exactly @p out.size() bytes, each poll() bounded by @p deadline. */
-  link_status receive(std::span<std::uint8_t> out, clock_type::time_point deadline) {
-    while (!out.empty()) {
-      const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - clock_type::now()).count();
-      if (left <= 0) return link_status::silent;
-      pollfd p{fd_, POLLIN, 0};
-      const int r = ::poll(&p, 1, static_cast<int>(left));
-      if (r < 0 && errno == EINTR) continue;
-      if (r < 0 || (p.revents & (POLLERR | POLLNVAL))) return link_status::io_error;
-      if (r == 0) return link_status::silent;
-      const auto n = ::read(fd_, out.data(), out.size());  // never more than asked: no over-read
-      if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-      if (n <= 0) return link_status::io_error;  // 0: hung up (unplugged adapter, closed pty)
-      out = out.subspan(static_cast<std::size_t>(n));
+  /** Bytes waiting, into @p in (never more than asked: no over-read); -1: hung up or failed. */
+  long read(std::span<std::uint8_t> in) {
+    for (;;) {
+      const auto n = ::read(fd_, in.data(), in.size());
+      if (n > 0) return static_cast<long>(n);
+      if (n == 0) return -1;  // hung up (an unplugged adapter, a closed pty)
+      if (errno == EINTR) continue;
+      return errno == EAGAIN || errno == EWOULDBLOCK ? 0 : -1;
     }
-    return link_status::ok;
   }
-  /** Drops bytes until the line has been quiet for 20 ms, for 200 ms at most (after a malformed reply). */
-  void drain() {
-    std::uint8_t junk[64];
+  /** Waits for input, until @p until at most (the link's deadline: never a wait without one). */
+  void idle(clock_type::time_point until) {
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(until - clock_type::now()).count();
     pollfd p{fd_, POLLIN, 0};
-    const auto give_up = clock_type::now() + std::chrono::milliseconds(200);
-    while (clock_type::now() < give_up && ::poll(&p, 1, 20) > 0 && ::read(fd_, junk, sizeof junk) > 0) {
-    }
+    ::poll(&p, 1, static_cast<int>(std::clamp<long long>(left, 0, 1000)));
   }
 
  private:
@@ -118,26 +104,24 @@ class fd_link {
 };
 
 /**
- * The same interface over memory: what is sent goes to rcb4's virtual board (sans-I/O), what it
- * answers is read back. A test double for a program's own tests; a fixed byte script would do too.
+ * The same over memory: what is written goes to rcb4's virtual board (sans-I/O), what it answers
+ * is read back at once. A test double for a program's own tests; a fixed byte script would do too.
  */
-class memory_link {
+class memory_device {
  public:
-  /** Passes @p bytes to the board; its replies queue up. */
-  link_status send(std::span<const std::uint8_t> bytes) {
-    now_ += std::chrono::milliseconds(1);  // board time: each exchange 1 ms later
-    board_.receive(bytes, now_, queued_);
-    return link_status::ok;
+  /** Gives @p out to the board; its replies queue up. */
+  long write(std::span<const std::uint8_t> out) {
+    now_ += std::chrono::milliseconds(1);  // board time: each write 1 ms later
+    board_.receive(out, now_, queued_);
+    return static_cast<long>(out.size());
   }
-  /** Takes exactly @p out.size() queued bytes; silent when fewer are queued (no clock needed). */
-  link_status receive(std::span<std::uint8_t> out, clock_type::time_point) {
-    if (queued_.size() < out.size()) return link_status::silent;
-    std::copy_n(queued_.begin(), out.size(), out.begin());
-    queued_.erase(queued_.begin(), queued_.begin() + static_cast<std::ptrdiff_t>(out.size()));
-    return link_status::ok;
+  /** What the board answered, into @p in. */
+  long read(std::span<std::uint8_t> in) {
+    const auto n = std::min(in.size(), queued_.size());
+    std::copy_n(queued_.begin(), n, in.begin());
+    queued_.erase(queued_.begin(), queued_.begin() + static_cast<std::ptrdiff_t>(n));
+    return static_cast<long>(n);
   }
-  /** Drops what is queued. */
-  void drain() { queued_.clear(); }
 
  private:
   rcb4::board::virtual_board board_;
@@ -145,79 +129,43 @@ class memory_link {
   std::vector<std::uint8_t> queued_;
 };
 
-/**
- * One exchange: @p cmd out, its reply in, by @p timeout, read into @p rx. The reply returned
- * points into @p rx (a parsed reply references its bytes, it does not copy them): keep @p rx
- * alive until the operation has taken the reply. A malformed reply (bad checksum, wrong length
- * or echo) to a read is retried up to twice after draining the line; a write is not repeated (a
- * CALL sent twice would push the board's stack twice). Silence and I/O errors end it.
- */
-template <class Link>
-std::optional<rcb4::reply> exchange(Link& link, const rcb4::command& cmd, link_status& status,
-                                    std::span<std::uint8_t, rcb4::max_reply_size> rx,
-                                    std::chrono::milliseconds timeout = std::chrono::milliseconds(500)) {
-  rcb4::request_frame frame;
-  const auto n = rcb4::serialize(cmd, frame.storage());
-  if (!n) {
-    std::fprintf(stderr, "the command does not serialize (%s)\n", rcb4::message(n.error()));
-    status = link_status::malformed;
-    return std::nullopt;
+/** Says on stderr what went wrong with each attempt, and that another follows. */
+struct stderr_observer {
+  template <class TimePoint>
+  void trace(rcb4::link::direction, TimePoint, std::span<const std::uint8_t>) noexcept {}
+  void count(rcb4::link::counter c, std::size_t = 1) noexcept {
+    if (c == rcb4::link::counter::retries) std::fprintf(stderr, "  retrying\n");
   }
-  frame.commit(*n);
-  const auto shape = rcb4::expected_reply(cmd);
-  const bool repeatable = shape.data || std::holds_alternative<rcb4::ping>(cmd);  // reads and ping only
-  for (int attempt = 0; attempt < (repeatable ? 3 : 1); ++attempt) {
-    if ((status = link.send(frame.bytes())) != link_status::ok) return std::nullopt;
-    std::size_t have = 0;
-    const auto deadline = clock_type::now() + timeout;
-    for (;;) {
-      const auto p = rcb4::parse_reply(rx.first(have), shape);
-      if (p.ok()) return p.value();  // ACK, NACK or data: the operation decides what NACK means
-      if (p.status == rcb4::parse_status::error) {
-        const bool again = repeatable && attempt + 1 < 3;
-        std::fprintf(stderr, "malformed reply (%s)%s\n", rcb4::message(p.error), again ? ", retrying" : "");
-        link.drain();
-        status = link_status::malformed;
-        break;
-      }
-      if ((status = link.receive(rx.subspan(have, p.needed), deadline)) != link_status::ok) {
-        if (status == link_status::silent && have > 0) {  // it began to answer, then stopped
-          std::fprintf(stderr, "the reply stopped short after %zu bytes\n", have);
-          status = link_status::malformed;
-        }
-        return std::nullopt;
-      }
-      have += p.needed;
-    }
+  void attempt_failed(rcb4::errc e) noexcept { std::fprintf(stderr, "  attempt failed: %s\n", rcb4::message(e)); }
+};
+
+/** The exit status for a failure (see the top of this file). */
+int exit_status(rcb4::errc e) {
+  switch (e) {
+    case rcb4::errc::link_timeout: return 4;
+    case rcb4::errc::link_closed:
+    case rcb4::errc::link_lost:
+    case rcb4::errc::link_io_error:
+    case rcb4::errc::link_reconnect_failed: return 3;
+    default: return 1;
   }
-  return std::nullopt;
 }
 
-/** Runs @p op to its end; the exit status of the first failure, or 0. */
+/** Runs @p op to its end over @p link; the exit status of a failure, or 0. */
 template <class Link, class Op>
 int run(Link& link, Op& op, const char* what) {
-  std::array<std::uint8_t, rcb4::max_reply_size> rx{};  // outlives each reply given to op.on_reply()
-  while (const auto c = op.next()) {
-    link_status status{};
-    const auto r = exchange(link, *c, status, std::span(rx));
-    if (!r) {
-      std::fprintf(stderr, "%s: %s\n", what,
-                   status == link_status::silent     ? "the board did not answer within 500 ms"
-                   : status == link_status::io_error ? "the line failed (unplugged?)"
-                                                     : "malformed replies (named above), given up");
-      return status == link_status::silent ? 4 : status == link_status::io_error ? 3 : 1;
-    }
-    op.on_reply(*r);
-  }
-  if (op.error() != rcb4::errc{}) {
-    std::fprintf(stderr, "%s: %s\n", what, rcb4::message(op.error()));
-    return 1;
-  }
-  return 0;
+  const auto e = rcb4::link::run(link, op);
+  if (e == rcb4::errc{}) return 0;
+  std::fprintf(stderr, "%s: %s\n", what, rcb4::message(e));
+  return exit_status(e);
 }
 
-template <class Link>
-int read_board(Link& link) {
+template <class Device>
+int read_board(Device& device) {
+  rcb4::link::options opt;
+  opt.baud = 115200;
+  opt.turnaround = std::chrono::milliseconds(500);  // each attempt's deadline: the wire time and this
+  rcb4::link::device_link<Device, clock_type, stderr_observer> link(device, opt);
   rcb4::ops::read_config config;
   if (const int rc = run(link, config, "read config")) return rc;
   std::printf("config word 0x%04X: COM %u baud, output period %u ms\n", config.value().encode(),
@@ -241,13 +189,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (std::string(argv[1]) == "--memory") {
-    memory_link link;
-    return read_board(link);
+    memory_device device;
+    return read_board(device);
   }
-  fd_link link(argv[1]);
-  if (link.fd() < 0) {
-    std::fprintf(stderr, "%s: %s\n", argv[1], link.why().c_str());
+  fd_device device(argv[1]);
+  if (device.fd() < 0) {
+    std::fprintf(stderr, "%s: %s\n", argv[1], device.why().c_str());
     return 3;
   }
-  return read_board(link);
+  return read_board(device);
 }

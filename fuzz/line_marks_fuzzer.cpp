@@ -1,4 +1,4 @@
-// libFuzzer harness: the decoder of a PARMRK-marked serial line (rcb4/transport/line_marks.hpp),
+// libFuzzer harness: the decoder of a PARMRK-marked serial line (rcb4/link/line_marks.hpp),
 // which reads whatever a serial port hands over. The first input byte chooses where the stream is
 // cut into reads; the rest is the raw stream. Properties:
 //   - never more data bytes than raw bytes, in every read;
@@ -7,7 +7,7 @@
 //     reading of termios(3)'s rules (FF FF = FF, FF 00 X = damaged X, FF Y = damaged) gives;
 //   - first_damaged <= clean_from <= size, and both 0 when nothing was damaged.
 // SPDX-License-Identifier: BSL-1.0
-#include <rcb4/transport/line_marks.hpp>
+#include <rcb4/link/line_marks.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -53,7 +53,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto want = reference(raw, n, want_damaged);
 
   for (const std::size_t step : {n > 0 ? n : std::size_t{1}, std::size_t{1}, std::size_t{cut % 7u + 1u}}) {
-    rcb4::transport::line_marks m;
+    rcb4::link::line_marks m;
     std::vector<std::uint8_t> got;
     std::size_t damaged = 0;
     for (std::size_t at = 0; at < n; at += step) {

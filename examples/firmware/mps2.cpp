@@ -55,17 +55,16 @@ void init() noexcept {
 
 std::uint32_t now_ms() noexcept { return g_ms; }
 
-bool uart_put(std::uint8_t b, std::uint32_t deadline) noexcept {
-  while (reg(uart_state) & state_tx_full)
-    if (static_cast<std::int32_t>(now_ms() - deadline) >= 0) return false;
+bool uart_poll_out(std::uint8_t b) noexcept {
+  if (reg(uart_state) & state_tx_full) return false;
   reg(uart_data) = b;
   return true;
 }
 
-std::optional<std::uint8_t> uart_get(std::uint32_t deadline) noexcept {
-  while (!(reg(uart_state) & state_rx_full))
-    if (static_cast<std::int32_t>(now_ms() - deadline) >= 0) return std::nullopt;
-  return static_cast<std::uint8_t>(reg(uart_data) & 0xFFu);
+bool uart_poll_in(std::uint8_t& b) noexcept {
+  if (!(reg(uart_state) & state_rx_full)) return false;
+  b = static_cast<std::uint8_t>(reg(uart_data) & 0xFFu);
+  return true;
 }
 
 void print(const char* text) noexcept { semihost(sys_write0, text); }

@@ -5,9 +5,9 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <optional>
 
 namespace mps2 {
 
@@ -17,11 +17,22 @@ void init() noexcept;
 /** Milliseconds since init(), counted by the SysTick interrupt. */
 std::uint32_t now_ms() noexcept;
 
-/** Sends @p b, waiting while the transmit register is full; false when it stayed full past @p deadline. */
-bool uart_put(std::uint8_t b, std::uint32_t deadline) noexcept;
+/** The millisecond clock as a std::chrono clock (what rcb4's link reads; it wraps after 49 days). */
+struct clock {
+  using rep = std::int64_t;                                     ///< ticks
+  using period = std::milli;                                    ///< a millisecond each
+  using duration = std::chrono::duration<rep, period>;          ///< a span of ticks
+  using time_point = std::chrono::time_point<clock, duration>;  ///< ticks since init()
+  static constexpr bool is_steady = true;                       ///< it never goes back
+  /** Now. */
+  static time_point now() noexcept { return time_point(duration(now_ms())); }
+};
 
-/** The next received byte, or nothing when none arrived before now_ms() reached @p deadline. */
-std::optional<std::uint8_t> uart_get(std::uint32_t deadline) noexcept;
+/** Sends @p b when the transmit register has room: true when it took it (never waits). */
+bool uart_poll_out(std::uint8_t b) noexcept;
+
+/** Takes a received byte into @p b: true when one was waiting (never waits). */
+bool uart_poll_in(std::uint8_t& b) noexcept;
 
 /** Writes @p text on the host's standard output (semihosting SYS_WRITE0). */
 void print(const char* text) noexcept;

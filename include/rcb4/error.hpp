@@ -65,10 +65,20 @@ enum class errc : std::uint8_t {
   ics_line_echo_mismatch,  ///< the one-wire line's echo differs from what was sent: a collision (ics.md §1)
   ics_bad_reply,           ///< an ICS reply's header, sub-command, ID or value is not the one asked (ics.md §2.3)
   ics_bad_eeprom,          ///< an EEPROM image with a byte above 0x0F or without the 0x5A check mark (ics.md §4.1)
+  // the link (rcb4/link/exchange_machine.hpp: what any transport's exchange can end with)
+  link_timeout,           ///< no (complete) reply within the exchange's deadline
+  link_truncated,         ///< a reply began but stopped short of its length before the deadline
+  link_echo,              ///< the line echoes what is sent (a loopback plug, not a board)
+  link_line_error,        ///< a byte of the reply failed its parity or framing check (a marked line)
+  link_closed,            ///< the line closed (end of file: cable unplugged, server gone)
+  link_lost,              ///< the link is gone (the driver's I/O said so: EIO, ENODEV ...)
+  link_io_error,          ///< the driver's I/O failed in another way (the driver knows the details)
+  link_reconnect_failed,  ///< the link was lost and reopening it failed until the policy gave up
+  link_cancelled,         ///< the exchange was cancelled (an input of the machine)
 };
 
 /** The last errc value (for tables and tests that walk every code). */
-inline constexpr errc errc_last = errc::ics_bad_eeprom;
+inline constexpr errc errc_last = errc::link_cancelled;
 
 /** A short English description of @p e, for logs and exceptions. */
 constexpr const char* message(errc e) noexcept {
@@ -126,6 +136,16 @@ constexpr const char* message(errc e) noexcept {
       return "the ICS line's echo differs from what was sent: another device talked at the same time (collision)";
     case errc::ics_bad_reply: return "the ICS reply is not the one asked (header, sub-command, ID or value differs)";
     case errc::ics_bad_eeprom: return "ICS EEPROM image invalid: a byte above 0x0F or no 0x5A check mark";
+    case errc::link_timeout: return "no reply from the board before the deadline";
+    case errc::link_truncated: return "the board's reply stopped short of its length before the deadline";
+    case errc::link_echo: return "the line echoes what is sent: a loopback, not an RCB-4";
+    case errc::link_line_error:
+      return "a byte of the reply failed its parity or framing check (a noisy line, a wrong rate, or a break)";
+    case errc::link_closed: return "the line was closed (unplugged cable or stopped server)";
+    case errc::link_lost: return "the link is gone (unplugged adapter?)";
+    case errc::link_io_error: return "the line's input or output failed";
+    case errc::link_reconnect_failed: return "the link was lost and could not be reopened (device still unplugged?)";
+    case errc::link_cancelled: return "the exchange was cancelled";
   }
   return "unknown rcb4 error";
 }

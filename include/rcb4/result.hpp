@@ -62,6 +62,15 @@ struct result_holds_error {
   static void ics_line_echo_mismatch() noexcept { __builtin_trap(); }
   static void ics_bad_reply() noexcept { __builtin_trap(); }
   static void ics_bad_eeprom() noexcept { __builtin_trap(); }
+  static void link_timeout() noexcept { __builtin_trap(); }
+  static void link_truncated() noexcept { __builtin_trap(); }
+  static void link_echo() noexcept { __builtin_trap(); }
+  static void link_line_error() noexcept { __builtin_trap(); }
+  static void link_closed() noexcept { __builtin_trap(); }
+  static void link_lost() noexcept { __builtin_trap(); }
+  static void link_io_error() noexcept { __builtin_trap(); }
+  static void link_reconnect_failed() noexcept { __builtin_trap(); }
+  static void link_cancelled() noexcept { __builtin_trap(); }
 };
 
 /// Fails a value() of a result holding @p e: in a constant expression at the function named
@@ -113,6 +122,15 @@ constexpr void bad_result_access(errc e) noexcept {
     case errc::ics_line_echo_mismatch: return result_holds_error::ics_line_echo_mismatch();
     case errc::ics_bad_reply: return result_holds_error::ics_bad_reply();
     case errc::ics_bad_eeprom: return result_holds_error::ics_bad_eeprom();
+    case errc::link_timeout: return result_holds_error::link_timeout();
+    case errc::link_truncated: return result_holds_error::link_truncated();
+    case errc::link_echo: return result_holds_error::link_echo();
+    case errc::link_line_error: return result_holds_error::link_line_error();
+    case errc::link_closed: return result_holds_error::link_closed();
+    case errc::link_lost: return result_holds_error::link_lost();
+    case errc::link_io_error: return result_holds_error::link_io_error();
+    case errc::link_reconnect_failed: return result_holds_error::link_reconnect_failed();
+    case errc::link_cancelled: return result_holds_error::link_cancelled();
   }
   bad_result_access();
 }

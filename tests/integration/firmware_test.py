@@ -28,10 +28,13 @@ if QEMU is None:
     print("SKIPPED: qemu-system-arm is not installed (cmake/install-deps.sh installs it)")
     sys.exit(77)
 
-# Budgets (docs/firmware.md), set from the figures measured on 2026-11-28 (11,360 bytes of code,
-# 0 of data, 260 of bss, a worst stack of 3,848 bytes) with a little room: a change that grows
-# the image or its stack past them must say why, here and in the docs.
-BUDGET_TEXT, BUDGET_DATA, BUDGET_BSS, BUDGET_STACK = 12000, 0, 288, 4096
+# Budgets (docs/firmware.md), set from the figures measured on 2026-11-28 with a little room: a
+# change that grows the image or its stack past them must say why, here and in the docs.
+#   11,360 bytes of code, 0 of data, 260 of bss, a worst stack of 3,848 bytes: the firmware's own
+#          exchange loop (retry a read after draining the line);
+#   15,324 / 0 / 4 / 4,520: the library's link (rcb4/link/: a resync by ping after any error,
+#          reads tried three times, a loopback named, damaged bytes refused) in place of that loop.
+BUDGET_TEXT, BUDGET_DATA, BUDGET_BSS, BUDGET_STACK = 16000, 0, 288, 4800
 
 if SIZE:
     out = subprocess.run([SIZE, ELF], capture_output=True, text=True).stdout.split("\n")
@@ -106,12 +109,15 @@ finally:
 for mode, silent, status, words in [
         (None, True, 1, "the board did not answer in time"),
         ("nack", False, 3, "ping: NACK"),
-        ("badsum", False, 2, "three malformed replies in a row"),
-        ("short", False, 2, "three malformed replies in a row")]:
+        ("badsum", False, 2, "ping: checksum mismatch"),
+        ("short", False, 2, "read config: reply status byte neither ACK (06) nor NACK (15)")]:
     board = StandIn(silent=silent, mode=mode, tcp=True)
     rc, out = firmware(board.path)
     name = mode or "silent"
     check(rc == status and words in out,
           f"a {name} board: exit status {status} and '{words}' (got {rc}: {out.strip().splitlines()[-1:]})")
+    if name == "badsum":  # the link's policy: a read (a ping) is tried three times, each failure named
+        check(out.count("attempt failed: checksum mismatch") == 3,
+              f"a badsum board: each of the ping's three attempts named ({out.count('attempt failed')} lines)")
 
 finish()

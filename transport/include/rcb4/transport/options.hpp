@@ -2,6 +2,8 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <rcb4/link/types.hpp>
+
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -10,16 +12,10 @@
 
 namespace rcb4::transport {
 
-/**
- * The wire time of @p bytes at @p baud with 8E1 framing: 11 bits a byte (protocol.md §1). What
- * the client's deadlines and the served board's pacing are made of.
- */
-constexpr std::chrono::nanoseconds wire_time(std::size_t bytes, std::uint32_t baud) noexcept {
-  return std::chrono::nanoseconds(static_cast<std::int64_t>(bytes) * 11 * 1'000'000'000 / (baud > 0 ? baud : 1));
-}
-
-/** Direction of a traced frame. */
-enum class direction : std::uint8_t { tx, rx };
+/** The wire time of bytes at a baud, 8E1 (rcb4/link/types.hpp). */
+using link::wire_time;
+/** Direction of a traced frame (rcb4/link/types.hpp). */
+using link::direction;
 
 /** Called with every frame on the line: direction, monotonic time, bytes. */
 using trace_function =
@@ -49,16 +45,11 @@ struct client_options {
 };
 
 /**
- * How a client reopens a lost link (EOF, EIO, ENODEV: an unplugged adapter, a stopped server).
- * Attempts are spaced by a delay that starts at first_delay and doubles up to max_delay; after
- * give_up_after without success the exchange fails with transport_errc::reconnect_failed, and
- * the next exchange starts trying again.
+ * How a client reopens a lost link (EOF, EIO, ENODEV: an unplugged adapter, a stopped server):
+ * the link's own policy (rcb4/link/types.hpp); after give_up_after the exchange fails with
+ * transport_errc::reconnect_failed.
  */
-struct reconnect_policy {
-  std::chrono::milliseconds first_delay{50};      ///< wait after the first failed attempt
-  std::chrono::milliseconds max_delay{1000};      ///< the longest wait between attempts
-  std::chrono::milliseconds give_up_after{5000};  ///< total time one exchange spends reconnecting
-};
+using link::reconnect_policy;
 
 /** What a client has done (readable from any thread). */
 struct client_counters {

@@ -1,8 +1,7 @@
-// rcb4 — the whole policy of one exchange and of the line, as a sans-I/O state machine.
-// SPDX-License-Identifier: BSL-1.0
-//
-// The machine never touches a stream or reads a clock. A driver (the Asio worker, the POSIX
-// caller-thread driver, a test) asks it what to do and tells it how that went, with the time:
+// rcb4 — the link's exchange machine (rcb4/link/exchange_machine.hpp, std only) as the Asio and
+// caller-thread drivers speak to it: Boost.System error codes in and out, the client's counters
+// and trace as its observer, std::chrono::steady_clock as its clock. The policy is all in the
+// link machine; this file only translates.
 //
 //   auto a = m.start(req, now, stray_bytes);
 //   while (a.what != action::kind::done) {
@@ -11,447 +10,159 @@
 //   }
 //   complete(a.ec, m.reply());
 //
-// What it decides (DESIGN.md §4, §8):
-// - one attempt = write the frame, then read exactly what the reply can still hold (the first
-//   byte is its length, so the next reply is never eaten), all before the attempt's deadline:
-//   the wire time of request and reply (11 bits a byte at 8E1, protocol.md §1) plus the
-//   turnaround allowance;
-// - after any error (timeout, a malformed reply, stray bytes, a cancelled exchange) the line is
-//   dirty, and the next attempt first resynchronises: it sends a ping (03 FE 01) and discards everything up
-//   to its ACK (the board answers in order, so a late or split reply cannot be taken for the next
-//   one), then the line must stay quiet for `quiet`;
-// - idempotent requests (ping, VERSION, MOV → COM) get `read_retries` more attempts, writes none
-//   unless `retry_writes`;
-// - a lost link (EOF, EIO, ENODEV ...) is reopened before the next attempt when the client can
-//   reopen it, with a backoff from `first_delay` doubling to `max_delay`, for `give_up_after`;
-// - a reply that is the request's own bytes coming back is a loopback, not a board;
-// - on a marked serial line (PARMRK, what open_serial sets) the bytes read are decoded
-//   (line_marks.hpp): a byte that failed its parity or framing check fails the attempt at once
-//   (line_error: resync, and retry if allowed), it never becomes data.
-// A well-formed reply ends the exchange without error, a NACK included: the client decides what
-// a NACK means for its caller (see basic_client::execute and exchange).
+// Errors out: the link's codes as transport_errc (timeout, truncated, echo, line_error, closed,
+// reconnect_failed, cancelled), a lost or failed stream as the stream's own error code, a
+// malformed or refused reply as rcb4::errc.
+// SPDX-License-Identifier: BSL-1.0
 #pragma once
 
-#include <rcb4/rcb4.hpp>
-#include <rcb4/transport/detail/exchange.hpp>
+#include <rcb4/link/exchange_machine.hpp>
 #include <rcb4/transport/error.hpp>
-#include <rcb4/transport/line_marks.hpp>
 #include <rcb4/transport/options.hpp>
 #include <rcb4/transport/response.hpp>
 
-#include <algorithm>
-#include <array>
 #include <chrono>
 #include <cstdint>
-#include <optional>
 #include <span>
 
 namespace rcb4::transport::detail {
 
 using clock = std::chrono::steady_clock;
 
-/** What a driver must do next. */
+/** What a driver must do next (the link's action, with an error code). */
 struct action {
-  /** The kinds of action. */
-  enum class kind : std::uint8_t {
-    write,   ///< write `out` (all of it, or report what was written) before `deadline`
-    read,    ///< read at most `in.size()` bytes into `in` before `deadline` (what arrives first)
-    reopen,  ///< reopen the link, not before `deadline`
-    done,    ///< the exchange has ended with `ec` (the reply is machine.reply())
-  };
-  kind what = kind::done;               ///< what to do
-  std::span<const std::uint8_t> out{};  ///< write: the bytes still to write
-  std::span<std::uint8_t> in{};         ///< read: where the bytes go
-  clock::time_point deadline{};         ///< write/read: give up then; reopen: not before then
-  clock::time_point expected{};         ///< read: when the reply is due on the wire (for busy polling)
-  error_code ec{};                      ///< done: the outcome
+  using kind = link::basic_action<clock::time_point>::kind;  ///< write, read, reopen, done
+  kind what = kind::done;                                    ///< what to do
+  std::span<const std::uint8_t> out{};                       ///< write: the bytes still to write
+  std::span<std::uint8_t> in{};                              ///< read: where the bytes go
+  clock::time_point deadline{};                              ///< write/read: give up then; reopen: not before
+  clock::time_point expected{};                              ///< read: when the reply is due on the wire
+  error_code ec{};                                           ///< done: the outcome
 };
 
-/** How the last action ended. */
+/** How the last action ended, as a stream says it. */
 struct io_result {
   std::size_t n = 0;       ///< bytes written or read (also with an error or a timeout)
   error_code ec{};         ///< the stream's error (end of file included), or the reopen's
   bool timed_out = false;  ///< the deadline passed first
 };
 
-/** The policy of one exchange at a time, and the state of the line between them. */
+/** The link machine's observer for a client: its counters, and its options' trace function. */
+struct client_observer {
+  client_counters* n = nullptr;        ///< where counts go
+  const client_options* opt = nullptr;  ///< whose trace is called
+  /** Calls the trace function, when one is set. */
+  void trace(link::direction d, clock::time_point t, std::span<const std::uint8_t> b) const {
+    if (opt->trace) opt->trace(d, t, b);
+  }
+  /** Adds @p k to counter @p c. */
+  void count(link::counter c, std::size_t k = 1) const noexcept {
+    switch (c) {
+      case link::counter::exchanges: n->exchanges += k; break;
+      case link::counter::errors: n->errors += k; break;
+      case link::counter::retries: n->retries += k; break;
+      case link::counter::timeouts: n->timeouts += k; break;
+      case link::counter::nacks: n->nacks += k; break;
+      case link::counter::resyncs: n->resyncs += k; break;
+      case link::counter::reconnects: n->reconnects += k; break;
+      case link::counter::bytes_out: n->bytes_out += k; break;
+      case link::counter::bytes_in: n->bytes_in += k; break;
+      case link::counter::line_errors: n->line_errors += k; break;
+    }
+  }
+  /** (The client reports the exchange's outcome, not each attempt's.) */
+  void attempt_failed(errc) const noexcept {}
+};
+
+/** The policy of one exchange at a time and the state of the line (link::exchange_machine). */
 class exchange_machine {
  public:
-  /** A machine using @p opt (read as it goes: change them only while no exchange runs). */
-  exchange_machine(const client_options& opt, client_counters& counters) noexcept : opt_(&opt), n_(&counters) {}
+  /** A machine using @p opt (read as it goes) and counting into @p counters. */
+  exchange_machine(const client_options& opt, client_counters& counters) noexcept
+      : m_(opt, client_observer{&counters, &opt}) {}
 
-  /**
-   * Whether the line's reads are marked (PARMRK: a damaged byte as FF 00 X, an intact FF doubled)
-   * and must be decoded. The drivers tell it for each descriptor; a change starts the decoder clean.
-   */
-  void set_marked(bool marked) noexcept {
-    if (marked != marked_) marks_.reset();
-    marked_ = marked;
-  }
+  /** Whether the line's reads are marked (PARMRK) and must be decoded. */
+  void set_marked(bool marked) noexcept { m_.set_marked(marked); }
   /** True while the line's reads are decoded as marked. */
-  bool marked() const noexcept { return marked_; }
-
+  bool marked() const noexcept { return m_.marked(); }
   /** Whether a lost link can be reopened (a reopen function is set), and with which policy. */
-  void set_reopen(bool can, reconnect_policy policy = {}) noexcept {
-    can_reopen_ = can;
-    policy_ = policy;
-  }
+  void set_reopen(bool can, reconnect_policy policy = {}) noexcept { m_.set_reopen(can, policy); }
 
-  /**
-   * Begins @p r (copied: a temporary is fine) at @p now. @p stray: bytes found waiting on
-   * the line before anything was sent (a late or duplicated reply): a resync comes first.
-   */
+  /** Begins @p r at @p now; @p stray: bytes found waiting on the line (a resync comes first). */
   action start(const request& r, clock::time_point now, std::size_t stray = 0) {
-    req_ = r;
-    attempt_ = 0;
-    attempts_ = 1 + ((r.idempotent || opt_->retry_writes) ? opt_->read_retries : 0);
+    stream_error_ = {};
     reply_ = response{};
-    telling_ = {};
-    if (stray > 0) dirty_ = true;
-    return begin_attempt(now);
+    return from(m_.start(link::request{r.frame, r.shape, r.idempotent}, now, stray));
   }
-
   /** The last action ended with @p r at @p now: what next. */
   action resume(const io_result& r, clock::time_point now) {
-    switch (phase_) {
-      case phase::reopen: return reopened(r, now);
-      case phase::sync_write:
-      case phase::write: return written(r, now);
-      case phase::sync_read: return sync_read(r, now);
-      case phase::read: return read(r, now);
-      case phase::echo_check: return echo_check(r, now);
-      case phase::idle: break;
-    }
-    return done(transport_errc::cancelled);  // nothing was running
+    const auto s = status_of(r);
+    if (s != link::io_status::ok && s != link::io_status::timed_out && !stream_error_) stream_error_ = r.ec;
+    return from(m_.resume(link::io_result{r.n, s}, now));
   }
-
-  /**
-   * The running exchange is abandoned (its I/O was cancelled, or the client is closing): it ends
-   * with @p ec, and the next one resynchronises first (part of a frame may be on the wire).
-   */
+  /** The running exchange is abandoned: it ends with @p ec; the next one resynchronises first. */
   action cancel(error_code ec = boost::asio::error::operation_aborted) {
-    if (phase_ == phase::idle) return done(ec);
-    if (phase_ != phase::reopen) dirty_ = true;
-    return finish(ec);
+    auto a = from(m_.cancel());
+    a.ec = ec;
+    return a;
   }
 
   /** The reply of an exchange that ended without error (ACK, NACK or data). */
   const response& reply() const noexcept { return reply_; }
   /** True while no exchange runs. */
-  bool idle() const noexcept { return phase_ == phase::idle; }
+  bool idle() const noexcept { return m_.idle(); }
   /** True when the next exchange will resynchronise first. */
-  bool dirty() const noexcept { return dirty_; }
+  bool dirty() const noexcept { return m_.dirty(); }
   /** True when the link was lost (the next exchange reopens it first, when it can). */
-  bool lost() const noexcept { return lost_; }
+  bool lost() const noexcept { return m_.lost(); }
   /** The link was replaced from outside (a new stream): it starts clean. */
-  void replaced() noexcept {
-    dirty_ = lost_ = false;
-    marks_.reset();
-  }
+  void replaced() noexcept { m_.replaced(); }
   /** The running attempt's deadline (while an exchange runs). */
-  clock::time_point deadline() const noexcept { return deadline_; }
+  clock::time_point deadline() const noexcept { return m_.deadline(); }
 
  private:
-  enum class phase : std::uint8_t { idle, reopen, sync_write, sync_read, write, read, echo_check };
-  // The resync's ping is the short one (protocol.md §4.11): its ACK differs from its frame, so a
-  // loopback plug, which echoes the frame, can never look like a board answering.
-  static constexpr std::array<std::uint8_t, 3> sync_ping{0x03, 0xFE, 0x01};
-  static constexpr std::array<std::uint8_t, 4> ping_ack{0x04, 0xFE, 0x06, 0x08};  // protocol.md §4.11
-  static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
+  using machine = link::exchange_machine<clock, client_options, client_observer>;
 
-  void trace(direction d, clock::time_point t, std::span<const std::uint8_t> b) const {
-    if (opt_->trace && !b.empty()) opt_->trace(d, t, b);
-  }
-
-  action done(error_code ec) const {
-    action a;
-    a.ec = ec;
-    return a;
-  }
-  action write(std::span<const std::uint8_t> bytes) const {
-    action a;
-    a.what = action::kind::write;
-    a.out = bytes;
-    a.deadline = deadline_;
-    return a;
-  }
-  action read_into(std::span<std::uint8_t> buf) const {
-    action a;
-    a.what = action::kind::read;
-    a.in = buf;
-    a.deadline = deadline_;
-    a.expected = expected_;
-    return a;
-  }
-  action reopen_at(clock::time_point t) const {
-    action a;
-    a.what = action::kind::reopen;
-    a.deadline = t;
-    return a;
+  /** What the stream's result is to the link: end of file and a lost link told apart from other failures. */
+  static link::io_status status_of(const io_result& r) noexcept {
+    if (r.timed_out) return link::io_status::timed_out;
+    if (!r.ec) return link::io_status::ok;
+    if (r.ec == boost::asio::error::eof || r.ec == transport_errc::closed) return link::io_status::closed;
+    return is_link_lost(r.ec) ? link::io_status::lost : link::io_status::failed;
   }
 
-  /**
-   * The first @p n bytes of @p buf as read: on a marked line they are decoded in place. Returns
-   * the data bytes' count; @p d says what was damaged (nothing on an unmarked line).
-   */
-  std::size_t decode(std::span<std::uint8_t> buf, std::size_t n, line_marks::decoded& d) {
-    n = std::min(n, buf.size());
-    n_->bytes_in += n;
-    if (!marked_) {
-      d = line_marks::decoded{};
-      d.size = n;
-      return n;
+  action from(const machine::action& a) {
+    action out;
+    out.what = a.what;
+    out.out = a.out;
+    out.in = a.in;
+    out.deadline = a.deadline;
+    out.expected = a.expected;
+    if (a.what == action::kind::done) {
+      out.ec = error_of(a.error);
+      if (a.error == errc{}) reply_ = response::from(m_.last_reply());
     }
-    d = marks_.decode(buf.first(n));
-    if (d.damaged > 0) n_->line_errors += d.damaged;
-    return d.size;
+    return out;
   }
 
-  /** A byte of a reply arrived damaged: the attempt fails (resync, and a retry where allowed). */
-  action damaged(clock::time_point now) { return attempt_failed(transport_errc::line_error, now); }
-
-  action begin_attempt(clock::time_point now) {
-    if (attempt_ > 0) ++n_->retries;
-    if (lost_ && can_reopen_) {  // (without a reopen, the attempt tries the line as it is: the OS says if it is gone)
-      phase_ = phase::reopen;
-      give_up_ = now + policy_.give_up_after;
-      delay_ = policy_.first_delay;
-      return reopen_at(now);
+  error_code error_of(errc e) const {
+    if (e == errc{}) return {};
+    switch (e) {
+      case errc::link_timeout: return transport_errc::timeout;
+      case errc::link_truncated: return transport_errc::truncated;
+      case errc::link_echo: return transport_errc::echo;
+      case errc::link_line_error: return transport_errc::line_error;
+      case errc::link_closed: return transport_errc::closed;
+      case errc::link_reconnect_failed: return transport_errc::reconnect_failed;
+      case errc::link_cancelled: return transport_errc::cancelled;
+      case errc::link_lost:
+      case errc::link_io_error: return stream_error_ ? stream_error_ : error_code(make_error_code(e));
+      default: return make_error_code(e);  // the reply's own: malformed, refused
     }
-    return dirty_ ? begin_sync(now) : begin_exchange(now);
   }
 
-  action begin_sync(clock::time_point now) {
-    ++n_->resyncs;
-    sync_ = sync_state{};
-    return begin_write(phase::sync_write, sync_ping, ping_ack.size(), now);
-  }
-
-  action begin_exchange(clock::time_point now) {
-    ex_.emplace(req_.frame.bytes(), req_.shape);
-    return begin_write(phase::write, req_.frame.bytes(), req_.shape.frame_size(), now);
-  }
-
-  /** Sends @p frame, whose reply has @p reply_bytes: the reply is due after both have crossed the wire. */
-  action begin_write(phase p, std::span<const std::uint8_t> frame, std::size_t reply_bytes, clock::time_point now) {
-    phase_ = p;
-    expected_ = now + wire_time(frame.size() + reply_bytes, opt_->baud);
-    deadline_ = expected_ + opt_->turnaround;
-    out_ = frame;
-    trace(direction::tx, now, out_);
-    return write(out_);
-  }
-
-  action reopened(const io_result& r, clock::time_point now) {
-    if (!r.ec) {
-      lost_ = dirty_ = false;
-      marks_.reset();  // a new descriptor (the driver says whether it is marked)
-      ++n_->reconnects;
-      return begin_exchange(now);
-    }
-    if (now >= give_up_) return finish(transport_errc::reconnect_failed);
-    const auto at = std::min(give_up_, now + delay_);
-    delay_ = std::min<clock::duration>(policy_.max_delay, delay_ * 2);
-    return reopen_at(at);
-  }
-
-  action written(const io_result& r, clock::time_point now) {
-    n_->bytes_out += r.n;
-    out_ = out_.subspan(std::min(r.n, out_.size()));
-    if (phase_ == phase::write) ex_->wrote(r.n);
-    if (r.timed_out) return timed_out(now);
-    if (r.ec) return line_failed(r.ec, now);
-    if (!out_.empty()) return write(out_);
-    if (phase_ == phase::sync_write) {
-      phase_ = phase::sync_read;
-      return read_into(junk_);
-    }
-    phase_ = phase::read;
-    return read_into(ex_->read_buffer());
-  }
-
-  action sync_read(const io_result& r, clock::time_point now) {
-    line_marks::decoded d;
-    const std::size_t n = decode(junk_, r.n, d);
-    trace(direction::rx, now, std::span(junk_).first(n));
-    if (d.damaged > 0) sync_ = sync_state{};  // an ACK with a damaged byte is no ACK: look for the next
-    for (std::size_t i = d.clean_from; i < n; ++i) {
-      std::rotate(sync_.tail.begin(), sync_.tail.begin() + 1, sync_.tail.end());
-      sync_.tail.back() = junk_[i];
-      ++sync_.seen;
-    }
-    if (r.ec && !r.timed_out) return line_failed(r.ec, now);
-    const bool at_ack = sync_.seen >= ping_ack.size() && sync_.tail == ping_ack;
-    if (r.timed_out) {
-      if (at_ack && sync_.synced) {  // the ACK, then silence: the line is clean
-        dirty_ = false;
-        return begin_exchange(now);
-      }
-      return sync_failed(now);
-    }
-    if (at_ack && n > 0) {  // our ACK, unless more bytes follow it within `quiet`
-      // (every restart of the quiet period counts: a line that keeps sending ACKs is not settling)
-      if (sync_.synced && ++sync_.resettled > max_resettles) return timed_out(now);
-      sync_.synced = true;
-      deadline_ = now + opt_->quiet;
-    } else if (n > 0 && sync_.synced) {  // more came after an ACK-like tail: read on to the real one
-      sync_.synced = false;
-      if (++sync_.resettled > max_resettles) return timed_out(now);
-      deadline_ = now + wire_time(2 * ping_ack.size(), opt_->baud) + opt_->turnaround;
-    }
-    return read_into(junk_);
-  }
-
-  /**
-   * The resync saw no ACK before its deadline. Silence is a timeout; anything else says what the
-   * line is: our ping coming back (a loopback), a NACK, an ACK with a bad checksum (wrong rate or
-   * parity), or bytes in no framing the board uses.
-   */
-  action sync_failed(clock::time_point now) {
-    static constexpr std::array<std::uint8_t, 4> ping_nack{0x04, 0xFE, 0x15, 0x17};  // protocol.md §2.2
-    const auto& t = sync_.tail;
-    if (sync_.seen == 0 || (sync_.seen >= 4 && t == ping_ack)) return timed_out(now);  // silence, or a late ACK
-    if (sync_.seen >= 3 && std::equal(sync_ping.begin(), sync_ping.end(), t.begin() + 1)) return finish_echo();
-    if (sync_.seen >= 4 && t == ping_nack) return attempt_failed(rcb4::errc::nack, now);
-    if (sync_.seen >= 4 && t[0] == 0x04 && t[1] == 0xFE && (t[2] == 0x06 || t[2] == 0x15))
-      return attempt_failed(rcb4::errc::bad_checksum, now);
-    return attempt_failed(rcb4::errc::bad_reply_length, now);
-  }
-
-  action read(const io_result& r, clock::time_point now) {
-    if (r.n > 0) {
-      const auto buf = ex_->read_buffer();
-      line_marks::decoded d;
-      const std::size_t n = decode(buf, r.n, d);
-      trace(direction::rx, now, buf.first(n));
-      if (d.damaged > 0) return damaged(now);  // (never more is read than the reply can hold: it is this reply's)
-      if (n > 0) ex_->received(n);
-    }
-    if (ex_->next() == exchange::step::done) return judge(now);
-    if (r.timed_out) return ex_->received_bytes().empty() ? timed_out(now) : truncated(now);
-    if (r.ec) return line_failed(r.ec, now);
-    return read_into(ex_->read_buffer());
-  }
-
-  /** A complete frame arrived: the reply, or a malformed frame (resync, and retry if allowed). */
-  action judge(clock::time_point now) {
-    const auto& p = ex_->result();
-    const auto got = ex_->received_bytes();
-    if (p.status == parse_status::error) {
-      const auto sent = req_.frame.bytes();
-      if (!got.empty() && got.size() <= sent.size() && std::equal(got.begin(), got.end(), sent.begin())) {
-        // It starts like our own frame: read the rest of it to tell a loopback (which returns the
-        // whole frame, however its bytes are split) from a malformed reply.
-        phase_ = phase::echo_check;
-        echo_.matched = got.size();
-        echo_.error = p.error;
-        return echo_.matched == sent.size() ? finish_echo() : read_into(echo_buffer());
-      }
-      return attempt_failed(p.error, now);
-    }
-    if (p.consumed < got.size()) dirty_ = true;  // bytes after the reply (a NACK read where data was due)
-    reply_ = response::from(p.value());
-    if (reply_.kind == reply_kind::nack) ++n_->nacks;
-    return finish({});
-  }
-
-  std::span<std::uint8_t> echo_buffer() { return std::span(junk_).first(req_.frame.size() - echo_.matched); }
-
-  action echo_check(const io_result& r, clock::time_point now) {
-    const auto sent = req_.frame.bytes();
-    line_marks::decoded d;
-    const std::size_t n = decode(echo_buffer(), r.n, d);
-    trace(direction::rx, now, std::span(junk_).first(n));
-    if (d.damaged > 0) return damaged(now);
-    if (!std::equal(junk_.begin(), junk_.begin() + static_cast<std::ptrdiff_t>(n),
-                    sent.begin() + static_cast<std::ptrdiff_t>(echo_.matched)))
-      return attempt_failed(echo_.error, now);  // not our frame after all: the malformed reply it was
-    echo_.matched += n;
-    if (echo_.matched == sent.size()) return finish_echo();
-    if (r.timed_out) return attempt_failed(echo_.error, now);
-    if (r.ec) return line_failed(r.ec, now);
-    return read_into(echo_buffer());
-  }
-
-  /** Our own bytes came back: a loopback, never a board (and no retry cures that). */
-  action finish_echo() {
-    dirty_ = true;
-    return finish(transport_errc::echo);
-  }
-
-  action timed_out(clock::time_point now) {
-    ++n_->timeouts;
-    return attempt_failed(transport_errc::timeout, now);
-  }
-
-  /** A reply began and stopped short: a timeout that says more (a board is there, the line fails). */
-  action truncated(clock::time_point now) {
-    ++n_->timeouts;
-    return attempt_failed(transport_errc::truncated, now);
-  }
-
-  /**
-   * The attempt failed in a way another attempt may cure: retry while attempts remain. The
-   * exchange reports the first failure that says more than a timeout (a malformed reply, then
-   * silence while resynchronising, is a line or board problem, not a missing board).
-   */
-  action attempt_failed(error_code ec, clock::time_point now) {
-    dirty_ = true;
-    if (!telling_ || telling_ == transport_errc::timeout) telling_ = ec;
-    if (++attempt_ < attempts_) return begin_attempt(now);
-    return finish(telling_);
-  }
-
-  /** The stream failed: final, unless the link was lost and can be reopened for a retry. */
-  action line_failed(error_code ec, clock::time_point now) {
-    if (ec == boost::asio::error::eof) ec = transport_errc::closed;
-    dirty_ = true;
-    if (!is_link_lost(ec)) return finish(ec);
-    lost_ = true;
-    if (can_reopen_) return attempt_failed(ec, now);
-    return finish(ec);
-  }
-
-  action finish(error_code ec) {
-    phase_ = phase::idle;
-    if (!ec) lost_ = false;  // the line works after all
-    ++n_->exchanges;
-    if (ec) ++n_->errors;
-    return done(ec);
-  }
-
-  struct sync_state {
-    std::array<std::uint8_t, 4> tail{};  // the last 4 bytes seen, newest last
-    std::size_t seen = 0;
-    unsigned resettled = 0;
-    bool synced = false;  // the tail was the ping's ACK
-  };
-
-  const client_options* opt_;
-  client_counters* n_;
-  bool can_reopen_ = false;
-  reconnect_policy policy_{};
-  // the line, between exchanges
-  bool marked_ = false;
-  line_marks marks_{};
-  bool dirty_ = false;
-  bool lost_ = false;
-  // the running exchange
-  phase phase_ = phase::idle;
-  request req_{};
-  unsigned attempt_ = 0, attempts_ = 1;
-  error_code telling_{};  // the most telling failure of the attempts so far
-  clock::time_point deadline_{}, expected_{};
-  std::span<const std::uint8_t> out_{};
-  std::optional<exchange> ex_;
-  sync_state sync_{};
-  struct {
-    std::size_t matched = 0;  // bytes of our frame seen coming back
-    error_code error{};       // what the reply is if the rest does not match
-  } echo_{};
-  std::array<std::uint8_t, 256> junk_{};
-  clock::time_point give_up_{};
-  clock::duration delay_{};
+  machine m_;
+  error_code stream_error_{};  // the first failure the stream reported in this exchange
   response reply_{};
 };
 

@@ -1,14 +1,14 @@
-// rcb4 — one request/reply exchange as a sans-I/O state machine (the client's loop drives it).
+// rcb4 — one request/reply exchange as a sans-I/O state machine (exchange_machine.hpp drives it).
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
-#include <rcb4/rcb4.hpp>
+#include <rcb4/reply.hpp>
 
 #include <array>
 #include <cstddef>
 #include <span>
 
-namespace rcb4::transport::detail {
+namespace rcb4::link {
 
 /**
  * Write the frame, then read until the reply parses. The machine never asks for more bytes than
@@ -63,4 +63,4 @@ class exchange {
   parse_result<reply> result_{};
 };
 
-}  // namespace rcb4::transport::detail
+}  // namespace rcb4::link
