@@ -13,8 +13,9 @@
 // deadlines.
 //
 // What a device gives the link (see device_link.hpp): write() and read() that never wait (bytes
-// taken or read, 0 for none now, negative when the device failed), and optionally idle(until),
-// which waits for input until a deadline (here: poll()).
+// taken or read, 0 for none now, negative when the device failed), and optionally
+// idle(until, waiting), which waits for input, room to write or time until a deadline (here:
+// poll()).
 // SPDX-License-Identifier: BSL-1.0
 #include <rcb4/board/virtual_board.hpp>
 #include <rcb4/link/device_link.hpp>
@@ -91,11 +92,11 @@ class fd_device {
       return errno == EAGAIN || errno == EWOULDBLOCK ? 0 : -1;
     }
   }
-  /** Waits for input, until @p until at most (the link's deadline: never a wait without one). */
-  void idle(clock_type::time_point until) {
+  /** Waits for @p w (input, room to write, or only time), until @p until at most (the link's deadline). */
+  void idle(clock_type::time_point until, rcb4::link::waiting w) {
     const auto left = std::chrono::ceil<std::chrono::milliseconds>(until - clock_type::now()).count();
-    pollfd p{fd_, POLLIN, 0};
-    ::poll(&p, 1, static_cast<int>(std::clamp<long long>(left, 0, 1000)));
+    pollfd p{fd_, static_cast<short>(w == rcb4::link::waiting::output ? POLLOUT : POLLIN), 0};
+    ::poll(&p, w == rcb4::link::waiting::time ? 0 : 1, static_cast<int>(std::clamp<long long>(left, 0, 1000)));
   }
 
  private:
@@ -130,9 +131,7 @@ class memory_device {
 };
 
 /** Says on stderr what went wrong with each attempt, and that another follows. */
-struct stderr_observer {
-  template <class TimePoint>
-  void trace(rcb4::link::direction, TimePoint, std::span<const std::uint8_t>) noexcept {}
+struct stderr_observer : rcb4::link::no_observer {
   void count(rcb4::link::counter c, std::size_t = 1) noexcept {
     if (c == rcb4::link::counter::retries) std::fprintf(stderr, "  retrying\n");
   }

@@ -2,7 +2,7 @@
 // sans-I/O operations and its link. No heap, no exceptions, no RTTI; nothing here but the
 // standard library and mps2.hpp (the board support: UART, millisecond clock, semihosting).
 //
-//   1. ping until the board answers (it may still be booting), 6 s at most;
+//   1. ping until the board answers (it may still be booting): pings begun within 6 s;
 //   2. read the config word (ops::read_config);
 //   3. read every allocated servo's trim, position and target through the planner
 //      (ops::read_servo_states_fixed: the allocation table, then the fewest reads);
@@ -48,10 +48,7 @@ struct uart {
 };
 
 /** Names each failed attempt on the host's console. */
-struct console_observer {
-  template <class TimePoint>
-  void trace(rcb4::link::direction, TimePoint, std::span<const std::uint8_t>) noexcept {}
-  void count(rcb4::link::counter, std::size_t = 1) noexcept {}
+struct console_observer : rcb4::link::no_observer {
   void attempt_failed(rcb4::errc e) noexcept {
     mps2::line l;
     l << "firmware: attempt failed: " << rcb4::message(e);

@@ -17,15 +17,25 @@ void init() noexcept;
 /** Milliseconds since init(), counted by the SysTick interrupt. */
 std::uint32_t now_ms() noexcept;
 
-/** The millisecond clock as a std::chrono clock (what rcb4's link reads; it wraps after 49 days). */
+/**
+ * The millisecond clock as a std::chrono clock (what rcb4's link reads), widened to 64 bits so that
+ * it never wraps: now_ms() wraps after 49.7 days, and a deadline across the wrap would otherwise
+ * lie 49 days ahead. Call now() at least once every 49 days (the link does, every exchange).
+ */
 struct clock {
   using rep = std::int64_t;                                     ///< ticks
   using period = std::milli;                                    ///< a millisecond each
   using duration = std::chrono::duration<rep, period>;          ///< a span of ticks
   using time_point = std::chrono::time_point<clock, duration>;  ///< ticks since init()
-  static constexpr bool is_steady = true;                       ///< it never goes back
-  /** Now. */
-  static time_point now() noexcept { return time_point(duration(now_ms())); }
+  /** Now (from the main thread only: it keeps the high word). */
+  static time_point now() noexcept {
+    static std::uint32_t last = 0;
+    static std::int64_t wraps = 0;
+    const std::uint32_t t = now_ms();
+    if (t < last) wraps += std::int64_t{1} << 32;
+    last = t;
+    return time_point(duration(wraps + t));
+  }
 };
 
 /** Sends @p b when the transmit register has room: true when it took it (never waits). */

@@ -1134,6 +1134,27 @@ TEST_CASE("machine: a write that meets a lost link fails, and the next exchange 
   CHECK(r.n.retries == 0);
 }
 
+TEST_CASE("machine: the stream's error is reported, never a failed reopen's", "[transport][machine]") {
+  rig r;
+  r.m.set_reopen(true, t::reconnect_policy{10ms, 80ms, 500ms});
+  const auto s = single_request();
+  auto a = r.start(s);
+  a = r.resume(wrote_all(a));
+  a = r.resume(failed(boost::asio::error::eof));  // lost: the next exchange reopens first
+  REQUIRE(a.what == kind::done);
+  r.now += 5ms;
+  a = r.start(s);
+  REQUIRE(a.what == kind::reopen);
+  a = r.resume(failed(t::os_error(ENODEV)), 1ms);  // the adapter is not back yet
+  REQUIRE(a.what == kind::reopen);
+  r.now = a.deadline;
+  a = r.resume(moved(0), 1ms);  // back
+  REQUIRE(a.what == kind::write);
+  a = r.resume(failed(t::os_error(EPIPE)));  // and gone again at the write: a write goes once
+  REQUIRE(a.what == kind::done);
+  CHECK(a.ec == t::os_error(EPIPE));  // what ended it, not the reopen's ENODEV
+}
+
 TEST_CASE("machine: without a reopen, a lost link is tried again as it is", "[transport][machine]") {
   rig r;
   const auto p = ping_request();

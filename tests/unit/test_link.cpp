@@ -99,12 +99,14 @@ struct block_device {
     if (line->gone) return -1;
     return static_cast<long>(line->read_bytes(in));
   }
-  void idle(sim_clock::time_point until) {
-    // To the next byte's arrival, or the deadline (what a blocking wait with a timeout does).
-    auto next = until;
-    if (!line->to_host.empty()) next = std::min(next, line->to_host.front().first);
+  void idle(sim_clock::time_point until, l::waiting w) {
+    // To the next byte's arrival, or the deadline, 1 ms at most (a wait that wakes every millisecond).
+    auto next = std::min(until, sim_clock::now() + 1ms);
+    if (w == l::waiting::input && !line->to_host.empty()) next = std::min(next, line->to_host.front().first);
     sim_clock::t = std::max(sim_clock::t + 1us, next.time_since_epoch());
+    ++idles;
   }
+  int idles = 0;
 };
 
 /** The same with reopen(): a device that comes back. */
@@ -134,10 +136,9 @@ struct polled_uart {
 };
 
 /** Counts what the machine tells its observer. */
-struct counting {
+struct counting : l::no_observer {
+  explicit counting(std::array<std::size_t, 10>* counts) : n(counts) {}
   std::array<std::size_t, 10>* n;
-  template <class T>
-  void trace(l::direction, T, std::span<const std::uint8_t>) noexcept {}
   void count(l::counter c, std::size_t k = 1) noexcept { (*n)[static_cast<std::size_t>(c)] += k; }
 };
 std::size_t of(const std::array<std::size_t, 10>& n, l::counter c) { return n[static_cast<std::size_t>(c)]; }
@@ -160,7 +161,7 @@ TEST_CASE("link: a device in libftdi's shape drives the virtual board", "[link]"
   board_line line;
   block_device dev{&line};
   std::array<std::size_t, 10> n{};
-  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), counting{&n});
+  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
 
   const auto r = link.exchange(l::request_of(ping{}));
   REQUIRE(r.has_value());
@@ -183,7 +184,7 @@ TEST_CASE("link: a silent board ends in link_timeout after the read's retries, a
   line.silent = true;
   block_device dev{&line};
   std::array<std::size_t, 10> n{};
-  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), counting{&n});
+  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
 
   const auto r = link.exchange(l::request_of(ping{}));
   REQUIRE(!r.has_value());
@@ -213,7 +214,7 @@ TEST_CASE("link: a lost or damaged reply is resynchronised and retried, a late o
   board_line line;
   block_device dev{&line};
   std::array<std::size_t, 10> n{};
-  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), counting{&n});
+  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
 
   line.drop_replies = 1;
   auto r = link.exchange(l::request_of(ping{}));
@@ -235,7 +236,10 @@ TEST_CASE("link: a lost or damaged reply is resynchronised and retried, a late o
   REQUIRE(!w.has_value());
   CHECK(w.error() == errc::bad_checksum);
 
-  // A reply nobody read (the board answered after the host gave up) waits on the line: drained, resync first.
+  // A reply nobody read (the board answered after the host gave up) waits on the line: drained, resync
+  // first. The line is clean before it (a ping went through).
+  REQUIRE(link.exchange(l::request_of(ping{})).has_value());
+  REQUIRE_FALSE(link.state().dirty());
   line.to_host.emplace_back(sim_clock::now(), 0x04);
   line.to_host.emplace_back(sim_clock::now(), 0xFE);
   const auto resyncs = of(n, l::counter::resyncs);
@@ -270,7 +274,7 @@ TEST_CASE("link: a device that goes away is lost, or reopened when it can be", "
   line.gone = false;
   reopening_device dev{{&line}};
   std::array<std::size_t, 10> n{};
-  l::device_link<reopening_device, sim_clock, counting> link(dev, at_115200(), counting{&n});
+  l::device_link<reopening_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
   STATIC_REQUIRE(l::device_link<reopening_device, sim_clock, counting>::can_reopen);
   REQUIRE(link.exchange(l::request_of(ping{})).has_value());
   line.gone = true;
@@ -280,22 +284,60 @@ TEST_CASE("link: a device that goes away is lost, or reopened when it can be", "
   CHECK(of(n, l::counter::reconnects) == 1);
 }
 
-TEST_CASE("link: a stop cancels the exchange, and the next one resynchronises first", "[link]") {
+TEST_CASE("link: a stop cancels the exchange while it waits, and the next one resynchronises first", "[link]") {
+  sim_clock::t = 0us;
+  board_line line;
+  line.silent = true;
+  block_device dev{&line};
+  std::array<std::size_t, 10> n{};
+  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
+  // A servo move (one attempt only), stopped 5 ms into the wait for its reply: cancelled, not timed out.
+  const auto r = link.exchange(l::request_of(single_servo{3, 7500, 10}), [] { return sim_clock::t >= 5ms; });
+  REQUIRE(!r.has_value());
+  CHECK(r.error() == errc::link_cancelled);
+  CHECK(sim_clock::t < 20ms);  // before the attempt's deadline
+  CHECK(of(n, l::counter::timeouts) == 0);
+  CHECK(of(n, l::counter::retries) == 0);
+  CHECK(of(n, l::counter::resyncs) == 0);
+  CHECK(link.state().dirty());
+  CHECK_FALSE(link.state().last_reply().has_value());
+  // A ping stopped the same way: no retry is begun after the stop.
+  const auto start = sim_clock::t;
+  const auto p = link.exchange(l::request_of(ping{}), [&] { return sim_clock::t >= start + 3ms; });
+  REQUIRE(!p.has_value());
+  CHECK(p.error() == errc::link_cancelled);
+  CHECK(of(n, l::counter::retries) == 0);
+  line.silent = false;
+  line.seen.clear();
+  REQUIRE(link.exchange(l::request_of(ping{})).has_value());
+  CHECK(bytes(line.seen.begin(), line.seen.begin() + 3) == sync_ping);
+}
+
+TEST_CASE("link: a line that never stops talking cannot hold an attempt open", "[link]") {
   sim_clock::t = 0us;
   board_line line;
   line.silent = true;
   block_device dev{&line};
   l::device_link<block_device, sim_clock> link(dev, at_115200());
-  int asked = 0;
-  const auto r = link.exchange(l::request_of(ping{}), [&] { return ++asked > 3; });
+  // Noise: a byte ready at every microsecond for a second (never an ACK, never a reply).
+  for (int i = 0; i < 1'000'000; i += 50) line.to_host.emplace_back(sim_clock::time_point(std::chrono::microseconds(i)), 0x55);
+  const auto r = link.exchange(l::request_of(ping{}));
   REQUIRE(!r.has_value());
-  CHECK(r.error() == errc::link_cancelled);
-  CHECK(sim_clock::t < 25ms);  // stopped within the first attempt, not after three
-  CHECK(link.state().dirty());
-  line.silent = false;
-  line.seen.clear();
-  REQUIRE(link.exchange(l::request_of(ping{})).has_value());
-  CHECK(bytes(line.seen.begin(), line.seen.begin() + 3) == sync_ping);
+  CHECK((r.error() == errc::link_timeout || r.error() == errc::bad_reply_length || r.error() == errc::link_truncated));
+  CHECK(sim_clock::t < 200ms);  // three attempts' deadlines, not the noise's second
+}
+
+TEST_CASE("link: a request no reply can fit is refused before anything is sent", "[link]") {
+  sim_clock::t = 0us;
+  board_line line;
+  block_device dev{&line};
+  l::device_link<block_device, sim_clock> link(dev, at_115200());
+  l::request r = l::request_of(ping{});
+  r.shape = reply_shape{0x00, true, 255};  // 258 bytes: more than a reply holds (protocol.md §2)
+  const auto got = link.exchange(r);
+  REQUIRE(!got.has_value());
+  CHECK(got.error() == errc::frame_too_long);
+  CHECK(line.seen.empty());
 }
 
 TEST_CASE("link: a polled UART (a byte at a time, no idle hook) drives the virtual board", "[link]") {
@@ -316,7 +358,7 @@ TEST_CASE("link: a polled UART (a byte at a time, no idle hook) drives the virtu
   CHECK(s.error() == errc::link_timeout);
 }
 
-TEST_CASE("link: the machine counts in the ticks of a millisecond clock, deadlines rounded up", "[link]") {
+TEST_CASE("link: the machine counts in the ticks of a millisecond clock, its deadlines never early", "[link]") {
   struct ms_clock {
     using duration = std::chrono::milliseconds;
     using time_point = std::chrono::time_point<ms_clock>;
@@ -328,12 +370,12 @@ TEST_CASE("link: the machine counts in the ticks of a millisecond clock, deadlin
   auto a = m.start(l::request_of(ping{}), ms_clock::time_point(10ms));
   REQUIRE(a.what == kind::write);
   CHECK(bytes(a.out.begin(), a.out.end()) == ping_frame);
-  // The ping and its ACK, 8 bytes at 115200 baud, 11 bits each: 764 µs, a tick late rather than
-  // early: 1 ms; then the turnaround.
-  CHECK(a.deadline == ms_clock::time_point(31ms));
+  // The ping and its ACK, 8 bytes at 115200 baud, 11 bits each: 764 µs, rounded up: 1 ms; the
+  // turnaround 20 ms; and one tick more, since a tick clock's now() is rounded down.
+  CHECK(a.deadline == ms_clock::time_point(32ms));
   a = m.resume(l::io_result{4, l::io_status::ok}, ms_clock::time_point(10ms));
   REQUIRE(a.what == kind::read);
   CHECK(a.in.size() == 4);  // exactly the ACK: never a byte of the next reply
   CHECK(a.expected == ms_clock::time_point(11ms));
-  CHECK(a.deadline == ms_clock::time_point(31ms));
+  CHECK(a.deadline == ms_clock::time_point(32ms));
 }

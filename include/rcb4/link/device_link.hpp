@@ -3,21 +3,25 @@
 // a clock the program supplies. Two shapes of device, each a few lines to write:
 //
 //   byte_device    long write(span<const uint8_t>), long read(span<uint8_t>): bytes taken or
-//                  read (0: none now), negative: the device failed. libftdi's ftdi_write_data and
-//                  ftdi_read_data have this shape (see libftdi_device.hpp), as has ESP-IDF's
-//                  uart_write_bytes / uart_read_bytes with a wait of 0.
+//                  read (0: none now), negative: the device failed (the link takes it as lost:
+//                  reopened when the device can be). libftdi's ftdi_write_data and ftdi_read_data
+//                  have this shape (see libftdi_device.hpp); so has a non-blocking descriptor.
 //   polled_uart    bool poll_in(uint8_t&) (a byte was waiting), bool poll_out(uint8_t) (it was
-//                  taken): a microcontroller's UART registers, Zephyr's uart_poll_in. Wrapped as a
+//                  taken): a microcontroller's UART status and data registers. (Zephyr's
+//                  uart_poll_in returns 0 when a byte was read: wrap it as `== 0`.) Wrapped as a
 //                  byte_device by polled_uart_device.
 //
 // Optional members of a device: `bool reopen()` (a lost device is reopened with the link's
-// backoff), `void idle(time_point until)` (called while waiting for the device: sleep, yield, or
-// wait for an interrupt until then; without it the link polls without pause).
+// backoff), `void idle(time_point until, waiting w)` (called while the link waits: for input, for
+// room to write, or only for time (a reopen's backoff); sleep, poll, or wait for an interrupt,
+// until then at most). Without it the link polls without pause. A stop (exchange(r, stopped)) is
+// noticed between calls: an idle() that blocks to its deadline delays it that long.
 //
 //   struct my_clock { using duration = std::chrono::duration<std::int64_t, std::milli>;
 //                     using time_point = std::chrono::time_point<my_clock>;
 //                     static time_point now() { return time_point(duration(ticks_ms())); } };
-//   rcb4::link::device_link<my_uart_device, my_clock> link(uart, opts);
+//   rcb4::link::polled_uart_device<my_uart> device(uart);
+//   rcb4::link::device_link<decltype(device), my_clock> link(device, opts);
 //   auto r = link.exchange(rcb4::link::request_of(rcb4::ping{}));   // result<reply>
 //
 // std only, no heap, no exceptions. The clock must not wrap (widen a 32-bit tick counter).
@@ -31,6 +35,7 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 namespace rcb4::link {
@@ -57,6 +62,13 @@ concept polled_uart = requires(U& u, std::uint8_t& in, std::uint8_t out) {
   { u.poll_out(out) } -> std::convertible_to<bool>;
 };
 
+/** What the link waits for when it calls a device's idle(). */
+enum class waiting : std::uint8_t {
+  input,   ///< bytes to read
+  output,  ///< room to write
+  time,    ///< only the time to pass (a reopen's backoff)
+};
+
 /** A polled UART as a byte_device: as many bytes as it takes or has now. */
 template <polled_uart Uart>
 class polled_uart_device {
@@ -77,10 +89,10 @@ class polled_uart_device {
   }
   /** The UART's own idle(), when it has one. */
   template <class TimePoint>
-  void idle(TimePoint until)
-    requires requires(Uart& u) { u.idle(until); }
+  void idle(TimePoint until, waiting w)
+    requires requires(Uart& u) { u.idle(until, w); }
   {
-    u_->idle(until);
+    u_->idle(until, w);
   }
 
  private:
@@ -90,7 +102,7 @@ class polled_uart_device {
 /**
  * One exchange at a time over @p Device, with the link's policy (exchange_machine.hpp). Not
  * thread-safe: one caller at a time. Reads into the machine's buffer: a reply is a view valid
- * until the next exchange.
+ * until the next exchange. It stays where it was made (the machine points into itself).
  */
 template <byte_device Device, link_clock Clock, class Observer = no_observer>
 class device_link {
@@ -98,8 +110,8 @@ class device_link {
   using machine = exchange_machine<Clock, options, Observer>;  ///< the policy
   using time_point = typename Clock::time_point;               ///< the clock's time
 
-  /** Over @p d (kept by reference) with @p opt (copied) and @p obs. */
-  explicit device_link(Device& d, const options& opt = {}, Observer obs = {}, reconnect_policy policy = {})
+  /** Over @p d (kept by reference) with @p opt (copied), @p policy for reopening, and @p obs. */
+  explicit device_link(Device& d, const options& opt = {}, reconnect_policy policy = {}, Observer obs = {})
       : d_(&d), opt_(opt), m_(opt_, obs) {
     m_.set_reopen(can_reopen, policy);
   }
@@ -107,8 +119,8 @@ class device_link {
   device_link& operator=(const device_link&) = delete;
 
   /** True when Device has reopen(): a lost device is reopened with the policy's backoff. */
-  static constexpr bool can_reopen = requires(Device& d) {
-    { d.reopen() } -> std::convertible_to<bool>;
+  static constexpr bool can_reopen = requires(Device& dev) {
+    { dev.reopen() } -> std::convertible_to<bool>;
   };
 
   /**
@@ -125,22 +137,25 @@ class device_link {
    */
   template <class Stopped>
   result<reply> exchange(const request& r, Stopped&& stopped) {
-    auto a = m_.start(r, Clock::now(), drain());
+    const std::size_t stray = drain();  // first: the time is read after it
+    auto a = m_.start(r, Clock::now(), stray);
     while (a.what != action_kind::done) {
-      if (stopped()) {
+      const auto done = perform(a, stopped);
+      if (!done) {
         a = m_.cancel();
         break;
       }
-      const auto done = perform(a, stopped);  // first: the time is read after it (argument order is unspecified)
-      a = m_.resume(done, Clock::now());
+      a = m_.resume(*done, Clock::now());  // the time read after the action (argument order is unspecified)
     }
     if (a.error != errc{}) return a.error;
-    return m_.last_reply();
+    return *m_.last_reply();
   }
 
   /** The options in force (change them only between exchanges). */
   options& settings() noexcept { return opt_; }
-  /** The machine (its observer, whether the line is dirty). */
+  /** Whether the device's reads are PARMRK-marked (a serial descriptor opened so): decoded then. */
+  void set_marked(bool marked) noexcept { m_.set_marked(marked); }
+  /** The machine: its observer, whether the line is dirty or lost. */
   const machine& state() const noexcept { return m_; }
 
  private:
@@ -158,37 +173,46 @@ class device_link {
     return n;
   }
 
-  void wait(time_point until) {
-    if constexpr (requires(Device& d) { d.idle(until); }) d_->idle(until);
+  void wait(time_point until, waiting w) {
+    if constexpr (requires(Device& dev) { dev.idle(until, w); }) d_->idle(until, w);
   }
 
-  /** Does @p a until it is done, its deadline passes, or @p stopped() (then the caller cancels). */
+  /**
+   * Does @p a until it is done or its deadline passes (checked before each try, as a driver must:
+   * a line that always has a byte ready cannot hold an attempt open); nothing when @p stopped().
+   */
   template <class Stopped>
-  io_result perform(const action& a, Stopped& stopped) {
+  std::optional<io_result> perform(const action& a, Stopped& stopped) {
     switch (a.what) {
       case action_kind::write:
         for (;;) {
+          if (stopped()) return std::nullopt;  // a stop comes before the deadline's timeout
+          if (Clock::now() >= a.deadline) return io_result{0, io_status::timed_out};
           const long n = d_->write(a.out);
-          if (n < 0) return {0, io_status::lost};
-          if (n > 0) return {static_cast<std::size_t>(n), io_status::ok};
-          if (Clock::now() >= a.deadline || stopped()) return {0, io_status::timed_out};
-          wait(a.deadline);
+          if (n < 0) return io_result{0, io_status::lost};
+          if (n > 0) return io_result{static_cast<std::size_t>(n), io_status::ok};
+          wait(a.deadline, waiting::output);
         }
       case action_kind::read:
         for (;;) {
+          if (stopped()) return std::nullopt;  // a stop comes before the deadline's timeout
+          if (Clock::now() >= a.deadline) return io_result{0, io_status::timed_out};
           const long n = d_->read(a.in);
-          if (n < 0) return {0, io_status::lost};
-          if (n > 0) return {static_cast<std::size_t>(n), io_status::ok};
-          if (Clock::now() >= a.deadline || stopped()) return {0, io_status::timed_out};
-          wait(a.deadline);
+          if (n < 0) return io_result{0, io_status::lost};
+          if (n > 0) return io_result{static_cast<std::size_t>(n), io_status::ok};
+          wait(a.deadline, waiting::input);
         }
       case action_kind::reopen:
-        while (Clock::now() < a.deadline && !stopped()) wait(a.deadline);
-        if constexpr (can_reopen) return {0, d_->reopen() ? io_status::ok : io_status::failed};
-        return {0, io_status::failed};
+        for (;;) {
+          if (stopped()) return std::nullopt;
+          if (Clock::now() >= a.deadline) break;
+          wait(a.deadline, waiting::time);
+        }
+        if constexpr (can_reopen) return io_result{0, d_->reopen() ? io_status::ok : io_status::failed};
+        return io_result{0, io_status::failed};
       case action_kind::done: break;
     }
-    return {};
+    return io_result{};
   }
 
   Device* d_;

@@ -4,12 +4,12 @@
 // tells it how that went, with the time from a clock it chooses:
 //
 //   rcb4::link::exchange_machine<my_clock> m(opts);
-//   auto a = m.start(rcb4::link::request::of(frame, shape, idempotent), now());
+//   auto a = m.start(rcb4::link::request_of(rcb4::ping{}), now());   // requests.hpp
 //   while (a.what != action::kind::done) {
 //     io_result r = perform(a);           // write a.out / read into a.in before a.deadline /
 //     a = m.resume(r, now());             // reopen the link, not before a.deadline
 //   }
-//   if (a.error == rcb4::errc{}) use(m.last_reply());   // ACK, NACK or data
+//   if (a.error == rcb4::errc{}) use(*m.last_reply());   // ACK, NACK or data
 //
 // What it decides (DESIGN.md §4, §8):
 // - one attempt = write the frame, then read exactly what the reply can still hold (the first
@@ -31,8 +31,11 @@
 // A well-formed reply ends the exchange without error, a NACK included: the caller decides what a
 // NACK means. Outcomes are the codec's errors (rcb4::errc: the link_* codes, and the reply's own).
 //
-// Time: any std::chrono-shaped clock, as its time_point and duration; deadlines are rounded up to
-// its ticks (a 1 ms tick on a microcontroller gives deadlines a tick late, never early).
+// Time: any std::chrono-shaped clock, as its time_point and duration (it must not wrap: widen a
+// 32-bit tick counter). Durations are rounded up to its ticks, and on a clock coarser than a
+// microsecond a deadline gets one tick more (its now() is rounded down): never early, at most two
+// ticks late. A reply complete when it is read is taken even past its deadline; bytes that keep
+// coming past it do not keep an attempt alive.
 // Tracing and counters go to an Observer (no_observer: nothing, compiled away); cancellation is an
 // input (cancel()).
 // SPDX-License-Identifier: BSL-1.0
@@ -56,8 +59,9 @@ namespace rcb4::link {
  * The policy of one exchange at a time, and the state of the line between them (see above).
  * @tparam Clock    gives time_point and duration (std::chrono::steady_clock, or a tick counter's)
  * @tparam Options  has baud, turnaround, quiet, read_retries, retry_writes (see options)
- * @tparam Observer may have trace(direction, time_point, bytes), count(counter, n) and
- *                  attempt_failed(errc): what it has is called (see no_observer)
+ * @tparam Observer has trace(direction, time_point, bytes), count(counter, n) and
+ *                  attempt_failed(errc): derive from no_observer and write the ones you want (a
+ *                  member with a wrong signature then hides the base's and fails to compile)
  */
 template <class Clock = std::chrono::steady_clock, class Options = options, class Observer = no_observer>
 class exchange_machine {
@@ -66,8 +70,13 @@ class exchange_machine {
   using duration = typename Clock::duration;      ///< its ticks
   using action = basic_action<time_point>;        ///< what to do next
 
-  /** A machine using @p opt (kept by reference) and @p obs. */
+  /** A machine using @p opt (kept by reference: it must outlive the machine) and @p obs. */
   explicit exchange_machine(const Options& opt, Observer obs = {}) noexcept : opt_(&opt), obs_(obs) {}
+  /** Not from a temporary: the machine keeps the options by reference. */
+  explicit exchange_machine(const Options&&, Observer = {}) = delete;
+  // Actions point into the machine (the frame, its buffers): it stays where it was made.
+  exchange_machine(const exchange_machine&) = delete;
+  exchange_machine& operator=(const exchange_machine&) = delete;
 
   /**
    * Whether the line's reads are marked (PARMRK: a damaged byte as FF 00 X, an intact FF doubled)
@@ -91,7 +100,12 @@ class exchange_machine {
    * line before anything was sent (a late or duplicated reply): a resync comes first.
    */
   action start(const request& r, time_point now, std::size_t stray = 0) {
+    if (r.shape.frame_size() > max_reply_size || r.frame.size() == 0) {  // a hand-made shape no reply can have
+      ex_.reset();
+      return done(errc::frame_too_long);
+    }
     req_ = r;
+    replied_ = false;
     attempt_ = 0;
     attempts_ = 1 + ((r.idempotent || opt_->retry_writes) ? opt_->read_retries : 0);
     ex_.reset();
@@ -120,16 +134,20 @@ class exchange_machine {
    * the wire).
    */
   action cancel(errc e = errc::link_cancelled) {
+    if (e == errc{}) e = errc::link_cancelled;  // a cancelled exchange has no reply
     if (phase_ == phase::idle) return done(e);
     if (phase_ != phase::reopen) dirty_ = true;
     return finish(e);
   }
 
   /**
-   * The reply of the last exchange that ended without error (ACK, NACK or data); a view into the
-   * machine, valid until the next start(). Read it only after a done action with no error.
+   * The reply of the last exchange, when it ended without error (ACK, NACK or data): a view into
+   * the machine, valid until the next start(); nothing after a failure or a cancel.
    */
-  rcb4::reply last_reply() const noexcept { return ex_->result().value(); }
+  std::optional<rcb4::reply> last_reply() const noexcept {
+    if (!idle() || !ex_ || ex_->result().status != parse_status::complete || !replied_) return std::nullopt;
+    return ex_->result().value();
+  }
   /** True while no exchange runs. */
   bool idle() const noexcept { return phase_ == phase::idle; }
   /** True when the next exchange will resynchronise first. */
@@ -155,29 +173,36 @@ class exchange_machine {
   static constexpr unsigned max_resettles = 8;  // a line that keeps talking after the ACK is not settling
 
   void trace(direction d, time_point t, std::span<const std::uint8_t> b) {
-    if constexpr (requires { obs_.trace(d, t, b); })
-      if (!b.empty()) obs_.trace(d, t, b);
+    if (!b.empty()) obs_.trace(d, t, b);
   }
-  /** Tells the observer, when it counts. */
-  void count(counter c, std::size_t n = 1) {
-    if constexpr (requires { obs_.count(c, n); }) obs_.count(c, n);
-  }
+  void count(counter c, std::size_t n = 1) { obs_.count(c, n); }
   /**
-   * The wire time of @p bytes (at most 383: a request and its reply) in the clock's ticks, rounded
-   * up. A clock of microseconds or coarser counts it in 32 bits (no 64-bit division on a
-   * microcontroller: 383 · 11 · 10^6 < 2^32); a finer one through wire_time().
+   * The wire time of @p bytes (at most 386: a 128-byte request and a 258-byte reply) in the clock's
+   * ticks, rounded up. A clock of microseconds or coarser counts it in 32 bits (no 64-bit division
+   * on a microcontroller); a finer one through wire_time().
    */
   duration wire_ticks(std::size_t bytes) const noexcept {
     using period = typename duration::period;
     if constexpr (period::num == 1 && period::den <= 1'000'000) {
-      const std::uint32_t bits = static_cast<std::uint32_t>(bytes) * 11u * static_cast<std::uint32_t>(period::den);
+      static_assert(std::uint64_t{386} * 11 * 1'000'000 < (std::uint64_t{1} << 32), "386 bytes of bits fit 32 bits");
+      const std::uint32_t bits = static_cast<std::uint32_t>(std::min<std::size_t>(bytes, 386)) * 11u *
+                                 static_cast<std::uint32_t>(period::den);
       const std::uint32_t baud = opt_->baud > 0 ? opt_->baud : 1u;
-      return duration(static_cast<typename duration::rep>((bits + baud - 1) / baud));
+      return duration(static_cast<typename duration::rep>(bits / baud + (bits % baud != 0 ? 1u : 0u)));
     } else {
       return ticks(wire_time(bytes, opt_->baud));
     }
   }
-  /** @p d as the clock's ticks, rounded up (a deadline never comes early). */
+  /**
+   * The deadline @p d after @p now: on a clock coarser than a microsecond one tick more, since its
+   * now() is rounded down (a deadline k ticks on could otherwise pass after k - 1 ticks and a bit).
+   */
+  static time_point after(time_point now, duration d) noexcept {
+    using period = typename duration::period;
+    constexpr bool coarse = static_cast<std::intmax_t>(period::num) * 1'000'000 > static_cast<std::intmax_t>(period::den);
+    return now + d + (coarse ? duration(1) : duration(0));
+  }
+  /** @p d as the clock's ticks, rounded up. */
   template <class Rep, class Period>
   static duration ticks(std::chrono::duration<Rep, Period> d) noexcept {
     return std::chrono::ceil<duration>(d);
@@ -256,7 +281,7 @@ class exchange_machine {
   action begin_write(phase p, std::span<const std::uint8_t> frame, std::size_t reply_bytes, time_point now) {
     phase_ = p;
     expected_ = now + wire_ticks(frame.size() + reply_bytes);
-    deadline_ = expected_ + ticks(opt_->turnaround);
+    deadline_ = after(now, wire_ticks(frame.size() + reply_bytes) + ticks(opt_->turnaround));
     out_ = frame;
     trace(direction::tx, now, out_);
     return write(out_);
@@ -313,11 +338,18 @@ class exchange_machine {
       // (every restart of the quiet period counts: a line that keeps sending ACKs is not settling)
       if (sync_.synced && ++sync_.resettled > max_resettles) return timed_out(now);
       sync_.synced = true;
-      deadline_ = now + ticks(opt_->quiet);
+      deadline_ = after(now, ticks(opt_->quiet));
     } else if (n > 0 && sync_.synced) {  // more came after an ACK-like tail: read on to the real one
       sync_.synced = false;
       if (++sync_.resettled > max_resettles) return timed_out(now);
-      deadline_ = now + wire_ticks(2 * ping_ack.size()) + ticks(opt_->turnaround);
+      deadline_ = after(now, wire_ticks(2 * ping_ack.size()) + ticks(opt_->turnaround));
+    }
+    if (now >= deadline_) {  // bytes keep coming past the deadline (a babbling line): it has passed all the same
+      if (at_ack && sync_.synced) {
+        dirty_ = false;
+        return begin_exchange(now);
+      }
+      return sync_failed(now);
     }
     return read_into(junk_);
   }
@@ -348,8 +380,9 @@ class exchange_machine {
       if (n > 0) ex_->received(n);
     }
     if (ex_->next() == exchange::step::done) return judge(now);
-    if (r.status == io_status::timed_out) return ex_->received_bytes().empty() ? timed_out(now) : truncated(now);
-    if (r.status != io_status::ok) return line_failed(r.status, now);
+    if (r.status != io_status::ok && r.status != io_status::timed_out) return line_failed(r.status, now);
+    if (r.status == io_status::timed_out || now >= deadline_)  // (a reply complete by now was taken above)
+      return ex_->received_bytes().empty() ? timed_out(now) : truncated(now);
     return read_into(ex_->read_buffer());
   }
 
@@ -371,6 +404,7 @@ class exchange_machine {
     }
     if (p.consumed < got.size()) dirty_ = true;  // bytes after the reply (a NACK read where data was due)
     if (p.value().kind() == reply_kind::nack) count(counter::nacks);
+    replied_ = true;
     return finish({});
   }
 
@@ -387,8 +421,8 @@ class exchange_machine {
       return attempt_failed(echo_.error, now);  // not our frame after all: the malformed reply it was
     echo_.matched += n;
     if (echo_.matched == sent.size()) return finish_echo();
-    if (r.status == io_status::timed_out) return attempt_failed(echo_.error, now);
-    if (r.status != io_status::ok) return line_failed(r.status, now);
+    if (r.status != io_status::ok && r.status != io_status::timed_out) return line_failed(r.status, now);
+    if (r.status == io_status::timed_out || now >= deadline_) return attempt_failed(echo_.error, now);
     return read_into(echo_buffer());
   }
 
@@ -416,7 +450,7 @@ class exchange_machine {
    */
   action attempt_failed(errc e, time_point now) {
     dirty_ = true;
-    if constexpr (requires { obs_.attempt_failed(e); }) obs_.attempt_failed(e);
+    obs_.attempt_failed(e);
     if (telling_ == errc{} || telling_ == errc::link_timeout) telling_ = e;
     if (++attempt_ < attempts_) return begin_attempt(now);
     return finish(telling_);
@@ -464,6 +498,7 @@ class exchange_machine {
   time_point deadline_{}, expected_{};
   std::span<const std::uint8_t> out_{};
   std::optional<exchange> ex_;
+  bool replied_ = false;  // the running or last exchange ended with a reply
   sync_state sync_{};
   struct {
     std::size_t matched = 0;  // bytes of our frame seen coming back

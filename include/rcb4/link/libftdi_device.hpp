@@ -2,7 +2,7 @@
 // libusb: no tty, no ftdi_sio driver, no file descriptor. A byte_device for device_link.hpp, which
 // brings the link's whole policy (deadlines, resync, retries, a write sent once, reopening an
 // adapter that was unplugged). Needs <ftdi.h> and -lftdi1 (Debian: libftdi1-dev; pkg-config
-// libftdi1); everything else in rcb4/link/ is std only.
+// libftdi1, version 1.5 or later for ftdi_tciflush); everything else in rcb4/link/ is std only.
 //
 //   rcb4::link::libftdi_device ftdi({0x165C, 0x0008}, 115200);   // KONDO's DUAL USB ADAPTER HS
 //   if (!ftdi.ok()) fail(ftdi.error());
@@ -14,12 +14,15 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <rcb4/link/device_link.hpp>
+
 #include <ftdi.h>
 
 #include <chrono>
 #include <cstdint>
 #include <span>
 #include <string>
+#include <thread>
 #include <utility>
 
 namespace rcb4::link {
@@ -60,6 +63,14 @@ class libftdi_device {
     if (n < 0) failed("read");
     return n;
   }
+  /**
+   * Waits while the link waits: only for a reopen's backoff does it sleep (until @p until); for
+   * input or room to write, a read or write already waits up to libftdi's 2 ms USB timeout.
+   */
+  template <class TimePoint>
+  void idle(TimePoint until, waiting w) {
+    if (w == waiting::time) std::this_thread::sleep_until(until);
+  }
   /** Closes and opens the same adapter again (after an unplug): true when it is back. */
   bool reopen() {
     close();
@@ -79,7 +90,7 @@ class libftdi_device {
     if (ftdi_set_latency_timer(ctx_, 1) < 0) return fail_open("the latency timer", true);
     if (ftdi_tciflush(ctx_) < 0) return fail_open("flushing its input", true);
     ctx_->usb_read_timeout = 2;  // ms: a read returns soon when nothing came (the link keeps the deadline)
-    ctx_->usb_write_timeout = 1000;
+    ctx_->usb_write_timeout = 100;  // ms: a 128-byte frame takes 12 ms at 115200
     open_ = true;
     error_.clear();
     return true;

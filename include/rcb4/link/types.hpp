@@ -64,11 +64,14 @@ enum class counter : std::uint8_t {
   resyncs,      ///< a resynchronisation (ping, discard to its ACK) after an error
   reconnects,   ///< the link was reopened after a loss
   bytes_out,    ///< bytes written (the count is the second argument)
-  bytes_in,     ///< bytes read, discarded ones included
+  bytes_in,     ///< bytes read, the resync's discarded ones included (not stray bytes a driver drains first)
   line_errors,  ///< bytes that failed their parity or framing check
 };
 
-/** The observer that observes nothing: every call compiles to nothing. */
+/**
+ * The observer that observes nothing: every call compiles to nothing. An observer of your own
+ * derives from it and writes the members it wants.
+ */
 struct no_observer {
   /** @p bytes went out or came in at @p t. */
   template <class TimePoint>

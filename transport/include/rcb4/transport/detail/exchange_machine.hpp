@@ -97,7 +97,14 @@ class exchange_machine {
   /** The last action ended with @p r at @p now: what next. */
   action resume(const io_result& r, clock::time_point now) {
     const auto s = status_of(r);
-    if (s != link::io_status::ok && s != link::io_status::timed_out && !stream_error_) stream_error_ = r.ec;
+    // The error the exchange reports for a lost or failed stream: the first one of its attempts
+    // (the machine keeps the most telling failure so), or the one that ends it at once (a failure
+    // that is no loss); a failed reopen is not the stream's (it ends in reconnect_failed, or is
+    // tried again).
+    if (last_ != action::kind::reopen) {
+      if (s == link::io_status::failed) stream_error_ = r.ec;
+      else if ((s == link::io_status::closed || s == link::io_status::lost) && !stream_error_) stream_error_ = r.ec;
+    }
     return from(m_.resume(link::io_result{r.n, s}, now));
   }
   /** The running exchange is abandoned: it ends with @p ec; the next one resynchronises first. */
@@ -132,6 +139,7 @@ class exchange_machine {
   }
 
   action from(const machine::action& a) {
+    last_ = a.what;
     action out;
     out.what = a.what;
     out.out = a.out;
@@ -140,7 +148,7 @@ class exchange_machine {
     out.expected = a.expected;
     if (a.what == action::kind::done) {
       out.ec = error_of(a.error);
-      if (a.error == errc{}) reply_ = response::from(m_.last_reply());
+      if (const auto r = m_.last_reply(); a.error == errc{} && r) reply_ = response::from(*r);
     }
     return out;
   }
@@ -162,7 +170,8 @@ class exchange_machine {
   }
 
   machine m_;
-  error_code stream_error_{};  // the first failure the stream reported in this exchange
+  error_code stream_error_{};  // the stream's failure this exchange reports (see resume)
+  action::kind last_ = action::kind::done;  // what the machine last asked for
   response reply_{};
 };
 
