@@ -2,6 +2,7 @@
 // SPDX-License-Identifier: BSL-1.0
 #pragma once
 
+#include <rcb4/link/requests.hpp>
 #include <rcb4/rcb4.hpp>
 
 #include <variant>
@@ -36,12 +37,8 @@ struct response {
   }
 };
 
-/** True for commands that can be repeated without changing the board: ping, VERSION, MOV → COM. */
-inline bool is_idempotent(const command& c) noexcept {
-  if (std::holds_alternative<ping>(c) || std::holds_alternative<version>(c)) return true;
-  if (const auto* m = std::get_if<move>(&c)) return m->dst().kind() == dst_kind::com;
-  return false;
-}
+/** True for commands that can be repeated without changing the board: ping, VERSION, MOV → COM (the link's rule). */
+inline bool is_idempotent(const command& c) noexcept { return link::is_idempotent(c); }
 
 /** A command ready for the line: its frame, the shape of its reply, whether it may be repeated. */
 struct request {
