@@ -358,6 +358,37 @@ TEST_CASE("link: a polled UART (a byte at a time, no idle hook) drives the virtu
   CHECK(s.error() == errc::link_timeout);
 }
 
+TEST_CASE("link: a control loop with no file descriptor: read the servos, move two, 50 times", "[link]") {
+  sim_clock::t = 0us;
+  board_line line;
+  block_device dev{&line};
+  std::array<std::size_t, 10> n{};
+  l::device_link<block_device, sim_clock, counting> link(dev, at_115200(), {}, counting{&n});
+  int arrived = 0;
+  for (int k = 0; k < 50; ++k) {
+    ops::read_servo_states_fixed states;
+    REQUIRE(l::run(link, states) == errc{});
+    REQUIRE(states.value().size() >= 2);
+    const auto a = states.value()[0].ics, b = states.value()[1].ics;
+    // Each round the two servos are sent to one side of the centre or the other, in one CONST frame.
+    const auto goal = servo_position::make(k % 2 == 0 ? 8000 : 7000).value();
+    servo_set<servo_position> targets;
+    targets.insert(a, goal);
+    targets.insert(b, goal);
+    const auto moved = link.exchange(l::request_of(const_servo::make(targets, frames{0}).value()));
+    REQUIRE(moved.has_value());
+    REQUIRE(moved->is_ack());
+    sim_clock::t += 20ms;  // the board's output periods pass: the servos get there
+    line.board.advance_to(std::chrono::duration_cast<board::board_time>(sim_clock::t));
+    if (k > 0)
+      for (const auto& s : states.value())
+        if (s.ics == a && s.position == (k % 2 == 0 ? 7000 : 8000)) ++arrived;  // last round's goal
+  }
+  CHECK(arrived == 49);  // each read saw where the move before it sent the servo
+  CHECK(of(n, l::counter::errors) == 0);
+  CHECK(of(n, l::counter::retries) == 0);
+}
+
 TEST_CASE("link: the machine counts in the ticks of a millisecond clock, its deadlines never early", "[link]") {
   struct ms_clock {
     using duration = std::chrono::milliseconds;
