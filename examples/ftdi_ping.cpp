@@ -49,7 +49,8 @@ int main(int argc, char** argv) {
   rcb4::link::libftdi_device::which w;
   std::uint32_t baud = 115200;
   if (argc > 3 || (argc >= 2 && !parse_ids(argv[1], w.vendor, w.product))) {
-    std::fprintf(stderr, "usage: rcb4_ftdi_ping [VID:PID [BAUD]]   (hex ids, e.g. 165c:0008; BAUD 115200, 625000, 1250000)\n");
+    std::fprintf(stderr,
+                 "usage: rcb4_ftdi_ping [VID:PID [BAUD]]   (hex ids, e.g. 165c:0008; BAUD 115200, 625000, 1250000)\n");
     return 2;
   }
   if (argc == 3) {
@@ -73,8 +74,8 @@ int main(int argc, char** argv) {
   // The short ping (03 FE 01): its ACK differs from its frame, so a loopback cannot pass for a board.
   const auto pong = link.exchange(rcb4::link::request_of(rcb4::ping{rcb4::ping_form::short_}));
   if (!pong) {
-    std::fprintf(stderr, "rcb4_ftdi_ping: ping: %s%s%s\n", rcb4::message(pong.error()), ftdi.error().empty() ? "" : ": ",
-                 ftdi.error().c_str());
+    std::fprintf(stderr, "rcb4_ftdi_ping: ping: %s%s%s\n", rcb4::message(pong.error()),
+                 ftdi.error().empty() ? "" : ": ", ftdi.error().c_str());
     return exit_status(pong.error());
   }
   std::printf("ping: %s\n", pong->is_ack() ? "ACK" : "NACK");

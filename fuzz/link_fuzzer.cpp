@@ -142,8 +142,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto got = m.last_reply();
     check(got.has_value() == (a.error == errc{}));  // a reply exactly when no error
     if (got)
-      check(got->is_nack() || (req.shape.data ? got->kind() == reply_kind::data && got->bytes().size() == req.shape.data_size
-                                              : got->is_ack()));
+      check(got->is_nack() ||
+            (req.shape.data ? got->kind() == reply_kind::data && got->bytes().size() == req.shape.data_size
+                            : got->is_ack()));
   }
   return 0;
 }

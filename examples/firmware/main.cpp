@@ -28,7 +28,7 @@
 namespace {
 
 constexpr std::chrono::milliseconds reply_allowance{1500};  // QEMU may hold the first byte for about 1 s
-constexpr std::uint32_t boot_deadline_ms = 6000;             // how long to ping a board that may be booting
+constexpr std::uint32_t boot_deadline_ms = 6000;            // how long to ping a board that may be booting
 
 enum class outcome { ok = 0, silent = 1, malformed = 2, refused = 3, not_arrived = 4, too_few_servos = 5 };
 

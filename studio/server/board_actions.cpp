@@ -35,16 +35,15 @@ json board_loop::move(std::vector<robot::joint_target> targets) {
   t::error_code ec;
   s_.run_steps(op, ec, [] {});
   if (ec) throw refusal{words_of(ec, "move")};
-  move_at_ms_ =
-      std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
+  move_at_ms_ = std::chrono::duration<double, std::milli>(std::chrono::system_clock::now().time_since_epoch()).count();
   std::chrono::milliseconds longest{0};
   for (const auto& mv : op.value())
     longest = std::max(longest, std::chrono::milliseconds(mv.frames * rcb4::milliseconds(op.period())));
   return json{{"ms", longest.count()}, {"joints", op.value().size()}};
 }
 
-
-rcb4::servo_mask board_loop::mask_of(const std::vector<const robot::joint*>& joints, std::vector<std::string>* missing) {
+rcb4::servo_mask board_loop::mask_of(const std::vector<const robot::joint*>& joints,
+                                     std::vector<std::string>* missing) {
   located();
   rcb4::servo_mask mask;
   for (const auto* j : joints) {
@@ -60,12 +59,9 @@ json board_loop::act(const power_action& a) {
   std::vector<std::string> missing;
   const auto mask = mask_of(a.joints, &missing);
   if (mask.empty()) throw refusal{"none of these joints has a servo block on the board (see rcb4 scan)"};
-  must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask),
-       a.free ? "free" : "hold");
+  must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask), a.free ? "free" : "hold");
   return json{{"joints", a.joints.size() - missing.size()}, {"missing", missing}};
 }
-
-
 
 json board_loop::act(const stop_action& a) {
   json out;
@@ -122,8 +118,7 @@ json board_loop::act(const capture_action& a) {
       const double h = std::round(*d * 100) / 100;
       const double within = std::clamp(h, r.j->lower, r.j->upper);
       if (std::abs(within - h) >= 0.05)
-        clamped.push_back(
-            fmt::format("{} {} (at {:.1f}, beyond its limit)", r.j->name, robot::number_text(within), h));
+        clamped.push_back(fmt::format("{} {} (at {:.1f}, beyond its limit)", r.j->name, robot::number_text(within), h));
       p.joints.emplace_back(r.j->name, within);
     } else {
       left_out.push_back(r.j->name);
@@ -173,9 +168,8 @@ json board_loop::act(const play_pose_action& a) {
         std::chrono::duration<double>(slowest()).count())};
   auto time = a.ms ? std::chrono::milliseconds(*a.ms) : p.time.value_or(h_.limits().default_pose_ms);
   if (time > slowest())
-    throw refusal{
-        fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period, not {} ms",
-                    slowest().count(), rcb4::milliseconds(period_), time.count())};
+    throw refusal{fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period, not {} ms",
+                              slowest().count(), rcb4::milliseconds(period_), time.count())};
   time = std::max(time, paced_time(span, h_.limits()));
   std::vector<robot::joint_target> targets;
   for (const auto& [name, d] : p.joints) targets.push_back({name, d, time});
@@ -203,8 +197,7 @@ json board_loop::act(const refresh_action&) {
 json board_loop::act(const motion_file_action& a) {
   const auto where = rcb4::motion::slot_of(*o_.layout, a.slot);
   if (!where || a.slot > o_.layout->motion_count)
-    throw refusal{
-        fmt::format("motion {} is outside this board's layout ({} slots)", a.slot, o_.layout->motion_count)};
+    throw refusal{fmt::format("motion {} is outside this board's layout ({} slots)", a.slot, o_.layout->motion_count)};
   const auto bytes = must(ops::read_memory(ops::memory::rom, where->address.value(), where->size), "read the motion");
   if (bytes.empty() || bytes[0] == 0xFF) throw refusal{fmt::format("motion {} is empty", a.slot)};
   const auto l = rcb4::motion::disassemble(bytes, *where);
@@ -221,6 +214,5 @@ json board_loop::act(const motion_file_action& a) {
               {"yaml", robot::motion_yaml(d, fmt::format("motion {} of the board, read by rcb4 ui", a.slot))},
               {"problem", robot::ok(again) ? json(nullptr) : json(std::get<robot::problem>(again).message)}};
 }
-
 
 }  // namespace cli::ui

@@ -99,7 +99,8 @@ void board_loop::notice_outside_writes() {
   }
 }
 
-// --- actions: each to its act() (board_actions.cpp) -------------------------------------------------------------------------------
+// --- actions: each to its act() (board_actions.cpp)
+// -------------------------------------------------------------------------------
 void board_loop::carry_out(const action& a) {
   const std::string_view op = std::visit(
       [](const auto& b) -> std::string_view {
@@ -143,13 +144,11 @@ void board_loop::carry_out(const action& a) {
       if (a.from) h_.tell(a.from, reply_text(a.id, op, extra.is_null() ? std::string() : text_of(extra)));
   } catch (const refusal& r) {
     if (a.from) h_.tell(a.from, error_text(a.id, op, r.what));
-  } catch (
-      const std::exception& e) {  // a failure nothing above turned into words: the page hears it, the loop goes on
+  } catch (const std::exception& e) {  // a failure nothing above turned into words: the page hears it, the loop goes on
     answering_ = false;
     if (a.from) h_.tell(a.from, error_text(a.id, op, plain_message(e.what())));
   }
 }
-
 
 void board_loop::located() {
   if (reader_) return;
@@ -163,8 +162,6 @@ void board_loop::refuse_during_motion() {
   if (!rom_program_) return;
   if (const auto why = rcb4::robot::services::move_refusal(motion_)) throw refusal{*why + " (stop it first)"};
 }
-
-
 
 void run_board_loop(session& s, const robot::model& m, hub& h, const loop_options& o) { board_loop(s, m, h, o).run(); }
 

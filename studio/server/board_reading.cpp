@@ -133,8 +133,8 @@ std::string board_loop::state_text() {
 std::vector<std::string> board_loop::pose_names() const {
   std::vector<std::string> out;
   t::error_code ec;
-  for (auto it = std::filesystem::directory_iterator(o_.poses, ec);
-       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+  for (auto it = std::filesystem::directory_iterator(o_.poses, ec); !ec && it != std::filesystem::directory_iterator();
+       it.increment(ec)) {
     const auto& p = it->path();
     if (!(p.extension() == ".yaml" || p.extension() == ".json") || !it->is_regular_file(ec)) continue;
     const auto stem = p.stem().string();
@@ -166,6 +166,5 @@ void board_loop::refresh_lists() {
   j["poses_dir"] = o_.poses.string();
   h_.set_lists(text_of(j));
 }
-
 
 }  // namespace cli::ui

@@ -55,8 +55,8 @@ studio::studio(server_options so) : options_(std::move(so)) {
   } catch (const boost::system::system_error& e) {
     const auto& a = options_.listen.address();
     throw failure(exit_io,
-                  fmt::format("cannot listen on {}{}{}:{}: {}", a.is_v6() ? "[" : "", a.to_string(), a.is_v6() ? "]" : "",
-                              options_.listen.port(), e.code().message()),
+                  fmt::format("cannot listen on {}{}{}:{}: {}", a.is_v6() ? "[" : "", a.to_string(),
+                              a.is_v6() ? "]" : "", options_.listen.port(), e.code().message()),
                   e.code() == boost::asio::error::address_in_use
                       ? "another program has that port: --listen 127.0.0.1:0 picks a free one"
                       : "");

@@ -41,14 +41,14 @@ struct sim_clock {
 struct board_line {
   board::virtual_board board;
   std::deque<std::pair<sim_clock::time_point, std::uint8_t>> to_host;  // bytes and when they arrive
-  bytes seen;                // every byte the host wrote, in order
-  bool silent = false;       // the board hears nothing
-  bool loopback = false;     // the line returns what is written, no board
-  int drop_replies = 0;      // replies lost on the wire
+  bytes seen;                                                          // every byte the host wrote, in order
+  bool silent = false;                                                 // the board hears nothing
+  bool loopback = false;                                               // the line returns what is written, no board
+  int drop_replies = 0;                                                // replies lost on the wire
   std::uint8_t drop_command = 0;  // the replies to this command byte are lost on the wire (0: none)
-  int damage_replies = 0;    // replies whose last byte (the checksum) is flipped
-  bool gone = false;         // the device went away (read and write fail)
-  int reopens = 0;           // reopen() calls
+  int damage_replies = 0;         // replies whose last byte (the checksum) is flipped
+  bool gone = false;              // the device went away (read and write fail)
+  int reopens = 0;                // reopen() calls
 
   void write_bytes(std::span<const std::uint8_t> out) {
     const auto now = sim_clock::now();
@@ -320,7 +320,8 @@ TEST_CASE("link: a line that never stops talking cannot hold an attempt open", "
   block_device dev{&line};
   l::device_link<block_device, sim_clock> link(dev, at_115200());
   // Noise: a byte ready at every microsecond for a second (never an ACK, never a reply).
-  for (int i = 0; i < 1'000'000; i += 50) line.to_host.emplace_back(sim_clock::time_point(std::chrono::microseconds(i)), 0x55);
+  for (int i = 0; i < 1'000'000; i += 50)
+    line.to_host.emplace_back(sim_clock::time_point(std::chrono::microseconds(i)), 0x55);
   const auto r = link.exchange(l::request_of(ping{}));
   REQUIRE(!r.has_value());
   CHECK((r.error() == errc::link_timeout || r.error() == errc::bad_reply_length || r.error() == errc::link_truncated));
