@@ -89,11 +89,10 @@ class polled_uart_device {
   }
   /** The UART's own idle(), when it has one. */
   template <class TimePoint>
-  void idle(TimePoint until, waiting w)
-    requires requires(Uart& u) { u.idle(until, w); }
-  {
-    u_->idle(until, w);
+  void idle(TimePoint until, waiting w) requires requires(Uart& u) {
+    u.idle(until, w);
   }
+  { u_->idle(until, w); }
 
  private:
   Uart* u_;
@@ -119,7 +118,7 @@ class device_link {
   device_link& operator=(const device_link&) = delete;
 
   /** True when Device has reopen(): a lost device is reopened with the policy's backoff. */
-  static constexpr bool can_reopen = requires(Device& dev) {
+  static constexpr bool can_reopen = requires(Device & dev) {
     { dev.reopen() } -> std::convertible_to<bool>;
   };
 
@@ -174,34 +173,35 @@ class device_link {
   }
 
   void wait(time_point until, waiting w) {
-    if constexpr (requires(Device& dev) { dev.idle(until, w); }) d_->idle(until, w);
+    if constexpr (requires(Device & dev) { dev.idle(until, w); }) d_->idle(until, w);
   }
 
   /**
-   * Does @p a until it is done or its deadline passes (checked before each try, as a driver must:
-   * a line that always has a byte ready cannot hold an attempt open); nothing when @p stopped().
+   * Calls @p io (a write or a read) until it moves bytes, fails, or @p deadline passes (checked
+   * before each try, as a driver must: a line that always has a byte ready cannot hold an attempt
+   * open), waiting for @p w between tries; nothing when @p stopped() (a stop comes before the
+   * deadline's timeout).
+   */
+  template <class Stopped, class Io>
+  std::optional<io_result> transfer(time_point deadline, waiting w, Stopped& stopped, Io io) {
+    for (;;) {
+      if (stopped()) return std::nullopt;
+      if (Clock::now() >= deadline) return io_result{0, io_status::timed_out};
+      const long n = io();
+      if (n < 0) return io_result{0, io_status::lost};
+      if (n > 0) return io_result{static_cast<std::size_t>(n), io_status::ok};
+      wait(deadline, w);
+    }
+  }
+
+  /**
+   * Does @p a until it is done or its deadline passes; nothing when @p stopped().
    */
   template <class Stopped>
   std::optional<io_result> perform(const action& a, Stopped& stopped) {
     switch (a.what) {
-      case action_kind::write:
-        for (;;) {
-          if (stopped()) return std::nullopt;  // a stop comes before the deadline's timeout
-          if (Clock::now() >= a.deadline) return io_result{0, io_status::timed_out};
-          const long n = d_->write(a.out);
-          if (n < 0) return io_result{0, io_status::lost};
-          if (n > 0) return io_result{static_cast<std::size_t>(n), io_status::ok};
-          wait(a.deadline, waiting::output);
-        }
-      case action_kind::read:
-        for (;;) {
-          if (stopped()) return std::nullopt;  // a stop comes before the deadline's timeout
-          if (Clock::now() >= a.deadline) return io_result{0, io_status::timed_out};
-          const long n = d_->read(a.in);
-          if (n < 0) return io_result{0, io_status::lost};
-          if (n > 0) return io_result{static_cast<std::size_t>(n), io_status::ok};
-          wait(a.deadline, waiting::input);
-        }
+      case action_kind::write: return transfer(a.deadline, waiting::output, stopped, [&] { return d_->write(a.out); });
+      case action_kind::read: return transfer(a.deadline, waiting::input, stopped, [&] { return d_->read(a.in); });
       case action_kind::reopen:
         for (;;) {
           if (stopped()) return std::nullopt;

@@ -89,7 +89,7 @@ class libftdi_device {
     if (ftdi_set_line_property(ctx_, BITS_8, STOP_BIT_1, EVEN) < 0) return fail_open("8E1", true);
     if (ftdi_set_latency_timer(ctx_, 1) < 0) return fail_open("the latency timer", true);
     if (ftdi_tciflush(ctx_) < 0) return fail_open("flushing its input", true);
-    ctx_->usb_read_timeout = 2;  // ms: a read returns soon when nothing came (the link keeps the deadline)
+    ctx_->usb_read_timeout = 2;     // ms: a read returns soon when nothing came (the link keeps the deadline)
     ctx_->usb_write_timeout = 100;  // ms: a 128-byte frame takes 12 ms at 115200
     open_ = true;
     error_.clear();
