@@ -48,7 +48,11 @@ function connect() {
     on[m.type]?.(m);
   };
   ws.onclose = () => {
-    setLink(false, 'no connection to rcb4 ui: is it still running? retrying…');
+    // The motion being edited is kept in this browser for this address only: an rcb4 ui started
+    // again on another port is another address, and the motion is not there. Said while it lasts.
+    const unsaved = ui.studio?.editor.history.dirty;
+    setLink(false, 'no connection to rcb4 ui: is it still running? retrying…' + (unsaved
+      ? ` Your motion has unsaved changes, kept in this browser for ${location.host} only: Save it to a file now (Save works without the connection)` : ''));
     setRole('view', false);
     setTimeout(connect, 1000);
   };
@@ -314,8 +318,10 @@ async function insertPose(name) {
 
 function playPose(name) {
   // the time the pose is played over: checked, never coerced (letters are no 0 ms snap)
-  const r = numberIn($('#pose-ms'), { min: 10, max: 6375, whole: true, what: 'play over', unit: ' ms' });
-  if (r.value === null) return say(r.why || 'play over: type a time in ms (10 to 6375)', 'error');
+  // (the server turns it into the board's frames, and stretches it to the speed limit)
+  const most = ui.hello?.max_move_ms ?? 6375;
+  const r = numberIn($('#pose-ms'), { min: 10, max: most, whole: true, what: 'play over', unit: ' ms' });
+  if (r.value === null) return say(r.why || `play over: type a time in ms (10 to ${most})`, 'error');
   send({ op: 'play_pose', name, ms: r.value });
 }
 
@@ -403,6 +409,7 @@ async function buildStudio(h) {
     request,
     send,
     say,
+    connected: () => ui.ws?.readyState === WebSocket.OPEN,
     view: null,
     measured: () => ({ ...ui.measured }),
     motions: () => ui.motions,
@@ -437,7 +444,12 @@ function selectJoint(name) {
 
 function wire() {
   $('#control').addEventListener('click', () => send({ op: ui.role === 'control' ? 'release' : 'control' }));
-  $('#free-all').addEventListener('click', () => send({ op: 'free', joints: ['all'] }));
+  // Every servo limp: a standing robot falls. Asked first (a joint's or a limb's Free does not ask).
+  $('#free-all').addEventListener('click', () => {
+    if (!window.confirm('Free all: every servo goes limp, and a robot standing or held up by its servos falls. Hold the robot first. Free every servo now?'))
+      return say('Free all cancelled: every servo as it was');
+    send({ op: 'free', joints: ['all'] });
+  });
   $('#hold-all').addEventListener('click', () => send({ op: 'hold', joints: ['all'] }));
   $('#stop').addEventListener('click', () => send({ op: 'stop' }));
   $('#motion-stop').addEventListener('click', () => send({ op: 'motion_stop' }));

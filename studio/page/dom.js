@@ -25,9 +25,11 @@ export const fmtDeg = (d) => (d === null || d === undefined ? '–' : (d > 0 ? '
  * The number typed in @p input, checked, never coerced: null when the box is empty (nothing is to
  * change) or holds no valid number in [min, max] (whole when @p whole): then the box is marked
  * with the reason (class "invalid", its title and validity message) and nothing may be applied
- * or sent. A browser number box reads "" for letters (validity.badInput): that is no 0.
+ * or sent. The check is @p check, or the one numberBox() gave the box. The raw text is read, so
+ * "4,5" or "12x" is refused as typed (a browser's type=number box would read 45 or 12).
  */
-export function numberIn(input, { min = -Infinity, max = Infinity, whole = false, what = 'the value', unit = '' } = {}) {
+export function numberIn(input, check = input.numberCheck ?? {}) {
+  const { min = -Infinity, max = Infinity, whole = false, multipleOf = 0, what = 'the value', unit = '' } = check;
   const mark = (why) => {
     input.classList.add('invalid');
     input.title = why;
@@ -43,9 +45,38 @@ export function numberIn(input, { min = -Infinity, max = Infinity, whole = false
   if (!Number.isFinite(v)) return mark(`${what}: '${text}' is not a number: nothing changed`);
   if (whole && !Number.isInteger(v)) return mark(`${what}: ${text} is not a whole number: nothing changed`);
   if (v < min || v > max) return mark(`${what}: ${text}${unit} is outside ${min}..${max}${unit}: nothing changed`);
+  if (multipleOf && Math.abs(v / multipleOf - Math.round(v / multipleOf)) > 1e-9)
+    return mark(`${what}: ${text}${unit} is not a multiple of ${multipleOf}${unit} (the board counts in steps of ${multipleOf}${unit}): nothing changed`);
   input.classList.remove('invalid');
   input.title = '';
   input.setCustomValidity?.('');
   input.removeAttribute('aria-invalid');
   return { value: v, why: null };
+}
+
+/**
+ * A box for a number: type=text (inputmode decimal or numeric), so what numberIn() reads is exactly
+ * what was typed; a browser's number box drops what it cannot parse ("12x" reads 12) or takes a
+ * comma as a grouping mark ("4,5" reads 45). @p check (numberIn's options, plus step) is kept on the
+ * box: it is marked or cleared as the user types (nothing is applied until 'change'), and ArrowUp /
+ * ArrowDown step it by check.step within [min, max] as a number box would.
+ */
+export function numberBox(attrs = {}, check = {}) {
+  const input = el('input', { type: 'text', inputmode: check.whole ? 'numeric' : 'decimal', autocomplete: 'off',
+    spellcheck: 'false', ...attrs, class: ['num', attrs.class].filter(Boolean).join(' ') });
+  input.numberCheck = check;
+  if (check.min !== undefined && check.max !== undefined && !input.title)
+    input.title = `${check.min} to ${check.max}${check.unit ?? ''}`;
+  input.addEventListener('input', () => { if (String(input.value).trim() !== '') numberIn(input); });
+  input.addEventListener('keydown', (e) => {
+    if ((e.key !== 'ArrowUp' && e.key !== 'ArrowDown') || !check.step) return;
+    const r = numberIn(input);
+    if (r.value === null) return;
+    e.preventDefault();
+    const next = r.value + (e.key === 'ArrowUp' ? check.step : -check.step);
+    const lo = check.min ?? -Infinity, hi = check.max ?? Infinity;
+    input.value = String(Math.round(Math.min(Math.max(next, lo), hi) * 1e6) / 1e6);
+    input.dispatchEvent(new Event('change', { bubbles: true }));
+  });
+  return input;
 }

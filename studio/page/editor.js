@@ -7,7 +7,7 @@
 import { canMirror, copyPose, mirrorPose, pastedPose } from './posetools.js';
 import { stepForm } from './stepforms.js';
 import { createFlowchart, flowMove, flowShift, fromFile, toFile } from './flowchart.js';
-import { el, $, numberIn } from './dom.js';
+import { el, $, numberIn, numberBox } from './dom.js';
 import { KINDS, describe, kindOf, segments } from './steps.js';
 import { createPlayback } from './playback.js';
 import { createBalance } from './balance.js';
@@ -23,10 +23,10 @@ export function createEditor(root, ctx) {
 
   // --- the parts of the panel ---
   const name = el('input', { id: 'ed-name', placeholder: 'motion name (names its slot)', maxlength: 64, 'aria-label': 'motion name' });
-  const slot = el('input', { id: 'ed-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot number' });
+  const slot = numberBox({ id: 'ed-slot', value: 10, 'aria-label': 'slot number' }, { min: 1, max: 120, whole: true, step: 1, what: 'the slot' });
   /** The slot typed, 1-120, or null (said, the box marked): nothing is read or written then. */
   const slotIn = () => {
-    const r = numberIn(slot, { min: 1, max: 120, whole: true, what: 'the slot' });
+    const r = numberIn(slot);
     if (r.value === null) ctx.say(r.why || 'type a slot number, 1 to 120', 'error');
     return r.value;
   };
@@ -226,6 +226,26 @@ export function createEditor(root, ctx) {
     if (!r.pose) return ctx.say(r.why, 'error');
     change(() => { s.pose = r.pose; });  // live on the robot: render() sends the pose
   }
+  // Mirror's signs come from the profile's body (docs/browser.md, "Mirror and a real robot"): no
+  // built-in body has been checked on a real robot, so the first mirror of a page asks, and a
+  // mirrored pose never goes to the robot by itself: "live" is turned off first (the user looks at
+  // it in the 3D view, then ticks live to send it).
+  let mirrorAsked = false;
+  function mirrorTool(which) {
+    if (kindOf(ed.doc.steps[ed.sel]) !== 'pose') return;
+    if (!mirrorAsked) {
+      if (!window.confirm(`Mirror takes each joint's turning sense from the ${h.robot} profile's body, which has not been checked on a real robot: `
+        + 'on yours a mirrored joint may turn the wrong way (docs/browser.md, "Mirror and a real robot", says how to check and fix it). '
+        + 'The mirrored pose is shown here first; it goes to the robot only when you tick "live". Mirror the pose?'))
+        return ctx.say('mirror cancelled: the pose is as it was');
+      mirrorAsked = true;
+    }
+    const wasLive = ed.live;
+    ed.live = false;
+    ed.liveSent = null;
+    reshape((p) => mirrorPose(h, p, which));
+    if (wasLive) ctx.say('mirrored; live is now off, so the robot did not move: look at the pose in the 3D view, then tick live to send it');
+  }
   function home() {  // every joint of the pose at 0°, the robot's home with its trims
     reshape((pose) => {
       const out = {};
@@ -355,9 +375,11 @@ export function createEditor(root, ctx) {
     }
     // A pose takes one board period at least (0 ms would snap the robot to it) and 255 frames at most.
     const period = ed.doc.period_ms || 10;
-    const time = el('input', { id: 'ed-time', type: 'number', min: period, max: 255 * period, step: period, value: s.time_ms, 'aria-label': 'time of the pose in ms' });
+    // The board counts a pose's time in whole periods (docs/motions.md §3): 1005 ms is refused, not rounded.
+    const time = numberBox({ id: 'ed-time', value: s.time_ms, 'aria-label': 'time of the pose in ms' },
+      { min: period, max: 255 * period, whole: true, multipleOf: period, step: period, what: 'the pose time', unit: ' ms' });
     time.addEventListener('change', () => {
-      const r = numberIn(time, { min: period, max: 255 * period, whole: true, what: 'the pose time', unit: ' ms' });
+      const r = numberIn(time);
       if (r.value === null) {
         if (r.why) ctx.say(`${r.why} (a pose takes ${period} to ${255 * period} ms: one to 255 periods of ${period} ms)`, 'error');
         else time.value = s.time_ms;  // emptied: nothing changes, the kept time back
@@ -374,7 +396,8 @@ export function createEditor(root, ctx) {
       const tick = el('input', { type: 'checkbox', 'aria-label': `${j.name} in this pose` });
       tick.checked = on;
       const slider = el('input', { type: 'range', min: j.lower, max: j.upper, step: 0.5, value: v, disabled: !on, 'aria-label': `${j.name} degrees` });
-      const num = el('input', { type: 'number', step: 0.5, value: Math.round(v * 10) / 10, disabled: !on, 'aria-label': `${j.name} degrees, typed` });
+      const num = numberBox({ value: Math.round(v * 10) / 10, disabled: !on, 'aria-label': `${j.name} degrees, typed` },
+        { min: j.lower, max: j.upper, step: 0.5, what: j.name, unit: '°' });
       const before = poseAt(ed.sel - 1)[j.name];
       const same = el('button', { type: 'button', class: 'as-before', text: '↶', disabled: !on || !Number.isFinite(before),
         title: Number.isFinite(before) ? `as in the pose before: ${Math.round(before * 10) / 10}°` : 'no angle before this pose',
@@ -385,7 +408,7 @@ export function createEditor(root, ctx) {
       tick.addEventListener('change', () => {
         if (!tick.checked) return change(() => { delete s.pose[j.name]; });
         // the joint joins the pose at the angle its box shows, checked as a typed one is
-        const r = numberIn(num, { min: j.lower, max: j.upper, what: j.name, unit: '°' });
+        const r = numberIn(num);
         if (r.value === null) { tick.checked = false; return ctx.say(r.why || `${j.name}: type its angle first`, 'error'); }
         change(() => { s.pose[j.name] = r.value; });  // live: render() sends the pose
       });
@@ -419,7 +442,7 @@ export function createEditor(root, ctx) {
       });
       num.addEventListener('change', () => {
         // letters or a cleared box are no angle: marked, nothing applied, nothing sent, nothing moves
-        const r = numberIn(num, { what: j.name, unit: '°' });
+        const r = numberIn(num);  // beyond the joint's limits: marked, its reason on the box
         if (r.value === null) {
           if (r.why) ctx.say(r.why, 'error');
           else num.value = s.pose[j.name];  // emptied: the kept angle back
@@ -431,9 +454,9 @@ export function createEditor(root, ctx) {
     });
     const mirrorable = canMirror(h), noBody = mirrorable ? '' : ' (this robot\'s profile has no body: kinematics)';
     const tools = el('div', { class: 'row small' },
-      bt('ed-mirror', 'Mirror ⇄', 'the pose mirrored left ↔ right (from the robot\'s body)' + noBody, () => reshape((p) => mirrorPose(h, p, 'both'))),
-      bt('ed-l2r', 'Left → right', 'the left limbs\' angles onto the right ones' + noBody, () => reshape((p) => mirrorPose(h, p, 'left'))),
-      bt('ed-r2l', 'Right → left', 'the right limbs\' angles onto the left ones' + noBody, () => reshape((p) => mirrorPose(h, p, 'right'))),
+      bt('ed-mirror', 'Mirror ⇄', 'the pose mirrored left ↔ right (from the robot\'s body)' + noBody, () => mirrorTool('both')),
+      bt('ed-l2r', 'Left → right', 'the left limbs\' angles onto the right ones' + noBody, () => mirrorTool('left')),
+      bt('ed-r2l', 'Right → left', 'the right limbs\' angles onto the left ones' + noBody, () => mirrorTool('right')),
       bt('ed-home', 'Home', 'every joint of this pose at 0° (the robot\'s home, with its trims)', home));
     for (const id of ['ed-mirror', 'ed-l2r', 'ed-r2l']) tools.querySelector(`#${id}`).disabled = !mirrorable;
     // Its name, shown in the list and on the timeline (kept in the motion file; the board never sees it).
@@ -482,9 +505,17 @@ export function createEditor(root, ctx) {
     } catch (e) { ctx.say(e.message, 'error'); }
   }
   async function save() {
+    const base = (name.value.trim() || 'motion').replace(/[^A-Za-z0-9_-]+/g, '_');
+    if (!ctx.connected()) {  // rcb4 ui gone: the motion file as JSON (the tool reads it as it reads YAML)
+      const a = el('a', { href: URL.createObjectURL(new Blob([text()], { type: 'application/json' })), download: base + '.json' });
+      a.click();
+      markClean();
+      setTimeout(() => URL.revokeObjectURL(a.href), 5000);
+      return ctx.say(`downloading ${a.download} (no connection to rcb4 ui: saved as JSON, unchecked; rcb4 motion push reads it): check your browser's downloads`);
+    }
     try {
       const r = await ctx.request({ op: 'motion_check', text: text() });
-      const a = el('a', { href: URL.createObjectURL(new Blob([r.yaml], { type: 'application/yaml' })), download: (name.value.trim() || 'motion').replace(/[^A-Za-z0-9_-]+/g, '_') + '.yaml' });
+      const a = el('a', { href: URL.createObjectURL(new Blob([r.yaml], { type: 'application/yaml' })), download: base + '.yaml' });
       a.click();
       markClean();
       setTimeout(() => URL.revokeObjectURL(a.href), 5000);

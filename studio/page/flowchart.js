@@ -120,6 +120,11 @@ export function createFlowchart(box, api) {
   box.replaceChildren(root);
   let drag = null;  // { kind: 'move'|'wire', i, dx, dy, x, y, moved }
 
+  // What covers the top of the page: the sticky header and the robot's panel above the editor. A
+  // block scrolled under them cannot be seen, so a drag there scrolls it into view and a drop there
+  // changes nothing (it would land on a block the user never saw).
+  const coveredTo = () => Math.max(0, ...[...document.querySelectorAll('header, .studio > .panel:first-child')]
+    .filter((x) => getComputedStyle(x).position === 'sticky').map((x) => x.getBoundingClientRect().bottom));
   const point = (e) => {
     const r = root.getBoundingClientRect();
     return { x: e.clientX - r.left, y: e.clientY - r.top };
@@ -167,16 +172,28 @@ export function createFlowchart(box, api) {
     drag.moved ||= Math.abs(p.x - drag.start.x) + Math.abs(p.y - drag.start.y) > 3;
     drag.x = p.x;
     drag.y = p.y;
-    // Near the box's top or bottom edge the box scrolls, so a jump reaches a block out of view.
-    const b = box.getBoundingClientRect();
-    if (e.clientY > b.bottom - 24) box.scrollTop += 16;
-    else if (e.clientY < b.top + 24) box.scrollTop -= 16;
+    // Near the box's bottom edge, or the top of what is seen of it, the box scrolls (then the page,
+    // when the box is scrolled to its top and its top is under the robot's panel), so a jump reaches
+    // a block out of view.
+    const b = box.getBoundingClientRect(), top = Math.max(b.top, coveredTo());
+    if (e.clientY > Math.min(b.bottom, window.innerHeight) - 24) {
+      if (box.scrollTop + box.clientHeight < box.scrollHeight) box.scrollTop += 16;
+      else window.scrollBy(0, 16);
+    } else if (e.clientY < top + 24) {
+      if (box.scrollTop > 0) box.scrollTop -= 16;
+      else if (b.top < coveredTo()) window.scrollBy(0, -16);
+    }
     render();
   });
   const end = (e) => {
     if (!drag) return;
     const d = drag, doc = api.doc();
     drag = null;
+    if (d.moved && e.clientY < coveredTo()) {  // let go over the robot's panel: nothing changes
+      api.say?.('dropped under the robot\'s panel: nothing changed (drag to a block you can see)', 'error');
+      render();
+      return;
+    }
     if (d.kind === 'wire') {
       if (d.moved) connect(d.i, blockAt(point(e), doc));
       render();

@@ -5,7 +5,7 @@
 // says what is wrong with the box marked (dom.js numberIn), and nothing changes then.
 // SPDX-License-Identifier: BSL-1.0
 
-import { el, numberIn } from './dom.js';
+import { el, numberIn, numberBox } from './dom.js';
 import { PAD, SYMBOL } from './remote.js';
 
 const COMPARES = [['equal', '='], ['not_equal', '≠'], ['below', '<'], ['at_least', '≥'], ['at_most', '≤']];
@@ -96,12 +96,12 @@ const KIND_FORMS = {
   },
 
   set_counter(s) {
-    const v = el('input', { id: 'f-count', type: 'number', min: 0, max: 255, value: s.set_counter, 'aria-label': 'counter value' });
+    const v = numberBox({ id: 'f-count', value: s.set_counter, 'aria-label': 'counter value' }, { min: 0, max: 255, whole: true, step: 1, what: 'the count' });
     const c = counterBox('f-counter', s);
     return {
       el: el('div', { class: 'row' }, field('counter =', v), field('counter at (RAM)', c)),
       read: () => {
-        const r = numberIn(v, { min: 0, max: 255, whole: true, what: 'the count' });
+        const r = numberIn(v);
         if (r.value === null) return fail(r.why || 'type the count, 0 to 255');
         const a = addressIn(c, 'the counter');
         if (a.why) return fail(a.why);
@@ -122,7 +122,7 @@ const KIND_FORMS = {
     size.value = String(s.size ?? 2);
     const how = el('select', { id: 'f-compare', 'aria-label': 'comparison' }, ...COMPARES.map(([k, t]) => el('option', { value: k, text: t })));
     how.value = COMPARES.map(([k]) => k).find((k) => k in s) ?? 'equal';
-    const value = el('input', { id: 'f-value', type: 'number', min: 0, max: 65535, value: s[how.value] ?? 0, 'aria-label': 'value compared with' });
+    const value = numberBox({ id: 'f-value', value: s[how.value] ?? 0, 'aria-label': 'value compared with' }, { min: 0, max: 65535, whole: true, step: 1, what: 'the value' });
     const to = labelPick('f-goto', s.goto, ctx.labels);
     return {
       el: el('div', { class: 'row' }, field('if RAM at', address), size, how, value, field('go to', to.sel)),
@@ -216,7 +216,7 @@ function params(s, ctx, kind) {
   const addRow = (key, value) => {
     const t = el('select', { class: 'param-target', 'aria-label': `${kind} of` }, ...targets.map((n) => el('option', { value: n, text: n })));
     t.value = targets.includes(key) ? key : 'all';
-    const v = el('input', { class: 'param-value', type: 'number', min: 1, max: 127, value, 'aria-label': `${kind} 1 to 127` });
+    const v = numberBox({ class: 'param-value', value, 'aria-label': `${kind} 1 to 127` }, { min: 1, max: 127, whole: true, step: 1, what: kind });
     const x = el('button', { type: 'button', text: '×', title: 'remove', 'aria-label': 'remove this row' });
     const row = el('div', { class: 'row' }, t, v, x);
     x.addEventListener('click', () => row.remove());

@@ -46,9 +46,15 @@ function describeKind(s) {
   if (k === 'if_ram') return `if RAM ${s.if_ram} … go to ${s.goto}`;
   if (k === 'goto') return `go to ${s.goto}`;
   if (k === 'call') return `call motion ${s.call}`;
-  const { name, ...rest } = s;  // eslint-disable-line no-unused-vars
-  return JSON.stringify(rest);
+  if (k === 'call_address') return `call the motion at ${hex(s.call_address)}`;
+  if (k === 'count_down') return `count down, then to ${s.count_down} once the counter is 0`;
+  if (k === 'speed' || k === 'stretch') return `${k} ${perJoint(s[k])}`;
+  return 'a step this page does not know';
 }
+
+const hex = (v) => (typeof v === 'number' ? '0x' + v.toString(16).toUpperCase().padStart(4, '0') : String(v));
+/** "all 127", "legs 60, head_yaw 90": a speed or stretch step's values in words, never JSON. */
+const perJoint = (m) => (m && typeof m === 'object' ? Object.entries(m).map(([k, v]) => `${k} ${v}`).join(', ') || 'of nothing' : String(m));
 
 /**
  * The motion as the board plays it: [{from, to, ms, step}] segments of interpolation, counters and

@@ -3,7 +3,7 @@
 // cleared, pressed and held to test a branch), trims (live, kept in ROM on request), the ROM backup.
 // Every change goes through the server's robot services, with their checks and refusals.
 
-import { el, numberIn } from './dom.js';
+import { el, numberIn, numberBox } from './dom.js';
 import { PAD, SYMBOL } from './remote.js';
 
 /** The CRC-32 (IEEE 802.3, as zlib and `rcb4 rom backup` compute it) of @p bytes. */
@@ -28,7 +28,7 @@ export function createTables(root, ctx) {
     pad.append(k);
   }
   const combo = el('span', { id: 'combo', class: 'combo' });
-  const bslot = el('input', { id: 'button-slot', type: 'number', min: 1, max: 120, value: 10, 'aria-label': 'slot the buttons play' });
+  const bslot = numberBox({ id: 'button-slot', value: 10, 'aria-label': 'slot the buttons play' }, { min: 1, max: 120, whole: true, step: 1, what: 'the slot' });
   const entries = el('ul', { id: 'button-entries', class: 'list' });
   const trims = el('div', { id: 'trims', class: 'trims' });
   const romFile = el('input', { id: 'rom-file', type: 'file', accept: '.bin', hidden: true });
@@ -44,7 +44,7 @@ export function createTables(root, ctx) {
     el('details', { id: 'buttons-panel' }, el('summary', {}, 'Remote buttons'), pad,
       el('div', { class: 'row' }, combo),
       el('div', { class: 'row' }, 'play slot', bslot,
-        bt('button-set', 'Assign', 'these buttons play the slot (ROM and RAM)', () => withCombo((b) => { const r = numberIn(bslot, { min: 1, max: 120, whole: true, what: 'the slot' }); if (r.value === null) return ctx.say(r.why || 'type a slot number, 1 to 120', 'error'); return ask({ op: 'button_set', buttons: b, slot: r.value }, null, showEntries); })),
+        bt('button-set', 'Assign', 'these buttons play the slot (ROM and RAM)', () => withCombo((b) => { const r = numberIn(bslot); if (r.value === null) return ctx.say(r.why || 'type a slot number, 1 to 120', 'error'); return ask({ op: 'button_set', buttons: b, slot: r.value }, null, showEntries); })),
         bt('button-clear', 'Clear', 'these buttons play nothing any more', () => withCombo((b) => ask({ op: 'button_clear', buttons: b }, null, showEntries)))),
       el('div', { class: 'row' },
         bt('button-press', 'Press', 'press them as the receiver would, until a motion starts', () => withCombo((b) => ask({ op: 'button_press', buttons: b }, `${b} pressed`))),
@@ -110,30 +110,40 @@ export function createTables(root, ctx) {
 
   // --- trims ---
   async function readTrims() {
+    if (!trims.children.length) trims.replaceChildren(el('div', { class: 'small muted', text: 'reading the trims…' }));
     const r = await ask({ op: 'trims' });
-    if (!r) return;
+    if (!r) return trims.replaceChildren(el('div', { class: 'small error', text: 'the trims could not be read (the message above says why): Read tries again' }));
     trims.replaceChildren(...r.trims.filter((t) => t.allocated).map((t) => {
-      const n = el('input', { type: 'number', min: -30, max: 30, step: 0.1, value: t.degrees, 'data-joint': t.name, class: 'needs-control', 'aria-label': `${t.name} trim in degrees` });
+      const n = numberBox({ value: t.degrees, 'data-joint': t.name, class: 'needs-control', 'aria-label': `${t.name} trim in degrees` },
+        { min: -30, max: 30, step: 0.1, what: `${t.name} trim`, unit: '°' });
       n.addEventListener('change', () => {
-        const typed = numberIn(n, { min: -30, max: 30, what: `${t.name} trim`, unit: '°' });
+        const typed = numberIn(n);
         if (typed.value === null) {
           if (typed.why) return ctx.say(typed.why, 'error');
           n.value = t.degrees;  // emptied: nothing changes, the board's trim back
           return;
         }
-        // read back at once: the row says what RAM and ROM hold now (never "in ROM" for a RAM change)
-        ask({ op: 'trim_set', joints: { [t.name]: typed.value } }, `${t.name} trim ${typed.value}° (RAM, not kept in ROM)`).then((ok) => { if (ok) readTrims(); });
+        // read back at once: the row says what RAM and ROM hold now (never "in ROM" for a RAM change),
+        // and the message what the board made of the degrees typed (it holds whole counts of a servo step)
+        ask({ op: 'trim_set', joints: { [t.name]: typed.value } }).then(async (ok) => {
+          if (!ok) return;
+          const now = (await readTrims())?.find((x) => x.name === t.name);
+          ctx.say(`${t.name} trim ${typed.value}° (RAM, not kept in ROM)` + (now
+            ? `: the board holds ${now.counts} counts, ${Math.round(now.exact_degrees * 1000) / 1000}°` : ''));
+        });
       });
+      n.title = `${t.counts} counts in RAM: ${Math.round(t.exact_degrees * 1000) / 1000}° (-30 to 30°)`;
       return el('div', { class: 'trim' }, el('span', { text: t.name }), n,
         el('span', { class: 'small muted', text: t.rom_degrees === null ? 'ROM –' : t.rom_degrees === t.degrees ? 'in ROM' : `ROM ${t.rom_degrees}` }));
     }));
     ctx.controls();
+    return r.trims;
   }
   persist.addEventListener('click', async () => {
     const joints = {};
     for (const n of trims.querySelectorAll('input[data-joint]')) {
       // every box must hold a trim: one that does not stops the whole write (nothing is kept in ROM)
-      const r = numberIn(n, { min: -30, max: 30, what: `${n.dataset.joint} trim`, unit: '°' });
+      const r = numberIn(n);
       if (r.value === null) return ctx.say(`${r.why || `${n.dataset.joint} trim: the box is empty`}: nothing was written to ROM`, 'error');
       joints[n.dataset.joint] = r.value;
     }

@@ -403,6 +403,8 @@ json studio_ops::trims() {
     out.push_back({{"name", t.j->name},
                    {"allocated", t.allocated},
                    {"degrees", t.allocated ? json(std::round(t.degrees() * 100) / 100) : json(nullptr)},
+                   {"counts", t.allocated ? json(t.ram) : json(nullptr)},  // what the board holds: whole counts
+                   {"exact_degrees", t.allocated ? json(t.degrees()) : json(nullptr)},
                    {"rom_degrees", rom ? json(std::round(*rom * 100) / 100) : json(nullptr)}});
   }
   return json{{"trims", out}};

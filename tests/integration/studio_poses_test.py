@@ -31,7 +31,7 @@ def click(driver, what):
 
 
 def typed(driver, joint, degrees):
-    js(driver, """const n = document.querySelector(`.pose-joint[data-joint="${arguments[0]}"] input[type=number]`);
+    js(driver, """const n = document.querySelector(`.pose-joint[data-joint="${arguments[0]}"] input.num`);
                   n.value = arguments[1]; n.dispatchEvent(new Event('change'));""", joint, degrees)
 
 
@@ -71,6 +71,7 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
                            ("right_shoulder_roll", -5), ("left_elbow_yaw", 12)):
             typed(driver, joint, deg)
         p0 = pose(driver)
+        js(driver, "window.confirm = () => true")  # the first mirror of a page asks (the profile's senses are unchecked)
         click(driver, "ed-mirror")
         p = pose(driver)
         check(p["head_yaw"] == -20 and p["left_knee"] == 10 and p["right_knee"] == 45
@@ -166,14 +167,19 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         field("f-label", "again")
         click(driver, "ed-step-apply")
         add("set_counter")
-        box = driver.find_element("id", "f-count")
-        box.clear()
-        box.send_keys("abc")  # as typed: a number box holds no value then (validity.badInput)
-        click(driver, "ed-step-apply")
-        bad = message(driver)
-        # (Chromium keeps letters out of a number box: it is left empty, and an empty count is no count)
-        check("nothing changed" in bad and js(driver, "return window.rcb4Studio.editor.doc.steps[1]") == {"set_counter": 3},
-              f"letters in the count: said, the step unchanged ({bad!r})")
+        # Typed with the keyboard, as the trial did: each is refused as typed (a browser number box
+        # read "12x" as 12 and "4,5" as 45), the box marked with the reason, the step unchanged.
+        for text in ("abc", "12x", "4,5", "1e9", "2.5"):
+            box = driver.find_element("id", "f-count")
+            box.clear()
+            box.send_keys(text)
+            marked_as_typed = js(driver, "return document.getElementById('f-count').classList.contains('invalid')")
+            click(driver, "ed-step-apply")
+            bad = message(driver)
+            check("nothing changed" in bad and marked_as_typed
+                  and js(driver, "return document.getElementById('f-count').title").startswith("the count")
+                  and js(driver, "return window.rcb4Studio.editor.doc.steps[1]") == {"set_counter": 3},
+                  f"{text!r} in the count: marked as typed, said, the step unchanged ({bad!r})")
         field("f-count", "4")
         click(driver, "ed-step-apply")
         add("pose")
@@ -193,9 +199,19 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         field("f-goto", "again")
         click(driver, "ed-step-apply")
         add("speed")
-        js(driver, """const t = document.querySelector('#ed-detail .param-target'); t.value = 'legs';
-                      document.querySelector('#ed-detail .param-value').value = 60;""")
+        js(driver, "document.querySelector('#ed-detail .param-target').value = 'legs'")
+        speed_box = driver.find_element("css selector", "#ed-detail .param-value")
+        speed_box.clear()
+        speed_box.send_keys("12x")
         click(driver, "ed-step-apply")
+        check("nothing changed" in message(driver)
+              and js(driver, "const s = window.rcb4Studio.editor.doc.steps; return s[s.length - 2]") == {"speed": {"all": 127}},
+              f"'12x' as a speed: refused, the step keeps all 127 ({message(driver)!r})")
+        speed_box.clear()
+        speed_box.send_keys("60")
+        click(driver, "ed-step-apply")
+        check("speed legs 60" in js(driver, "return document.querySelector('#ed-steps').textContent"),
+              "the speed step is listed in words (speed legs 60), never as JSON")
         steps = js(driver, "return window.rcb4Studio.editor.doc.steps")
         shape = [s if not (isinstance(s, dict) and "pose" in s) else "pose" for s in steps]
         check(shape == [{"label": "again"}, {"set_counter": 4}, "pose", {"if_buttons": "s1+circle", "goto": "again"},
@@ -259,6 +275,9 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         def block_xy(i):
             return js(driver, """const r = document.querySelector(`#ed-flow .flow-block[data-step="${arguments[0]}"]`).getBoundingClientRect();
                                  return [r.x, r.y];""", i)
+        # (scrolled to where a user sees it: below the sticky robot panel, clear of the autoscroll edges)
+        js(driver, """const b = document.querySelector('#ed-flow .flow-block[data-step="2"]');
+                      window.scrollBy(0, b.getBoundingClientRect().top - window.innerHeight * 0.6);""")
         x0, y0 = block_xy(2)  # the first pose
         js(driver, """const svg = document.getElementById('ed-flow');
             const b = svg.querySelector('.flow-block[data-step="2"]').getBoundingClientRect();
@@ -271,6 +290,21 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         click(driver, "ed-undo")
         x2, y2 = block_xy(2)
         check(abs(x2 - x0) < 2 and abs(y2 - y0) < 2, "one Undo puts it back")
+        # Let go over the sticky robot panel (where the blocks scrolled under it cannot be seen):
+        # nothing changes, and the page says so.
+        flow_before = js(driver, "return JSON.stringify(window.rcb4Studio.editor.doc.flow || null)")
+        depth = js(driver, "return window.rcb4Studio.editor.history.undo")
+        js(driver, """const svg = document.getElementById('ed-flow');
+            const b = svg.querySelector('.flow-block[data-step="2"]').getBoundingClientRect();
+            const under = document.querySelector('.studio > .panel:first-child').getBoundingClientRect().bottom - 30;
+            const at = (x, y) => ({ bubbles: true, pointerId: 1, clientX: x, clientY: y });
+            svg.dispatchEvent(new PointerEvent('pointerdown', at(b.x + 20, b.y + 10)));
+            svg.dispatchEvent(new PointerEvent('pointermove', at(b.x + 20, under)));
+            svg.dispatchEvent(new PointerEvent('pointerup', at(b.x + 20, under)));""")
+        check(js(driver, "return JSON.stringify(window.rcb4Studio.editor.doc.flow || null)") == flow_before
+              and js(driver, "return window.rcb4Studio.editor.history.undo") == depth
+              and "under the robot's panel" in message(driver),
+              f"a block let go over the robot's panel: nothing changed, said ({message(driver)!r})")
         field("ed-slot", "13")
         click(driver, "ed-push")
         check(wait_until(lambda: "motion 13" in message(driver), timeout=20), f"the flowchart's motion pushed to slot 13 ({message(driver)!r})")

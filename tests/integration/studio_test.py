@@ -113,7 +113,7 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         click(driver, "id", "ed-capture")
         js(driver, "document.querySelector('#ed-kind').value = 'pose'")
         click(driver, "id", "ed-add")  # a pose from the ghost (the last one), then typed
-        js(driver, """const n = document.querySelector('.pose-joint[data-joint="left_knee"] input[type=number]');
+        js(driver, """const n = document.querySelector('.pose-joint[data-joint="left_knee"] input.num');
                       n.value = 10; n.dispatchEvent(new Event('change'));""")
         doc = js(driver, "return window.rcb4Studio.editor.doc")
         kinds = ["pose" if isinstance(s, dict) and "pose" in s else s for s in doc["steps"]]
@@ -156,9 +156,10 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         times = [s["time_ms"] for s in js(driver, "return window.rcb4Studio.editor.doc")["steps"][:3]]
         check(times == [500, 400, 500], f"undo, redo: the same ({times})")
         # A typed value beyond a limit is refused, not taken.
-        js(driver, """const n = document.querySelector('.pose-joint[data-joint="head_yaw"] input[type=number]');
+        js(driver, """const n = document.querySelector('.pose-joint[data-joint="head_yaw"] input.num');
                       n.value = 300; n.dispatchEvent(new Event('change'));""")
-        check("beyond its limits" in message(driver)
+        check("is outside" in message(driver)
+              and js(driver, "return document.querySelector('.pose-joint[data-joint=\"head_yaw\"] input.num').title").startswith("head_yaw: 300°")
               and js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose.head_yaw") == 15,
               f"300° on head_yaw is refused, the pose keeps 15 ({message(driver)!r})")
         # Typed values are checked, never coerced (issue 41): with "live on the robot" ticked, what
@@ -167,8 +168,10 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         from selenium.webdriver.common.keys import Keys as K
         click(driver, "id", "ed-live")
         wait_until(lambda: abs((measured(driver, "left_knee") or 0) + 20) < 0.6, timeout=10)
-        knee_box = '.pose-joint[data-joint="left_knee"] input[type=number]'
-        for typed, what in (("--5", "letters (not a number)"), ("", "an emptied box")):
+        knee_box = '.pose-joint[data-joint="left_knee"] input.num'
+        # (typed with the keyboard, as the trial did: a browser's number box read "4,5" as 45 and "12x" as 12)
+        for typed, what in (("4,5", "a decimal comma"), ("12x", "a trailing letter"), ("--5", "letters (not a number)"),
+                            ("", "an emptied box")):
             box = driver.find_element(By.CSS_SELECTOR, knee_box)
             js(driver, "arguments[0].scrollIntoView({block: 'center'})", box)
             box.send_keys(K.CONTROL, "a")
@@ -182,11 +185,33 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
             check(kept == -20 and abs((measured(driver, "left_knee") or 0) + 20) < 0.6 and (marked or not typed),
                   f"{what} in left_knee with live on: the pose keeps -20, the robot stays, "
                   f"the box {'marked' if typed else 'restored'} ({kept}, {measured(driver, 'left_knee')}, {message(driver)!r})")
-        click(driver, "id", "ed-live")  # live off
-        for typed in ("--1", "", "0", "5"):
-            js(driver, "const t = document.querySelector('#ed-time'); t.value = arguments[0]; t.dispatchEvent(new Event('change'))", typed)
+        # Mirror with live on: the first mirror asks (the profile's signs are unchecked on a real
+        # robot); the mirrored pose is not sent: live goes off and the robot stays where it is.
+        kept_pose = js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose")
+        js(driver, "window.confirm = () => false")
+        click(driver, "id", "ed-mirror")
+        check(js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose") == kept_pose and "cancelled" in message(driver),
+              f"Mirror, answered No: the pose unchanged ({message(driver)!r})")
+        js(driver, "window.confirm = () => true")
+        click(driver, "id", "ed-mirror")
+        mirrored = js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose")
+        time.sleep(0.6)  # three board periods and more: a move sent would show
+        check(mirrored != kept_pose and mirrored.get("right_knee") == -20
+              and not js(driver, "return document.getElementById('ed-live').checked")
+              and abs((measured(driver, "left_knee") or 0) + 20) < 0.6 and abs((measured(driver, "head_yaw") or 0) - 15) < 0.6,
+              f"Mirror with live on: mirrored in the editor, live off, the robot unmoved ({mirrored}, {message(driver)!r})")
+        click(driver, "id", "ed-undo")
+        check(js(driver, "return window.rcb4Studio.editor.doc.steps[1].pose") == kept_pose, "Undo: the pose as it was")
+        for typed in ("--1", "", "0", "5", "12x", "4,5", "1005"):  # 1005: not a whole number of 10 ms periods
+            box = driver.find_element(By.ID, "ed-time")
+            box.send_keys(K.CONTROL, "a")
+            box.send_keys(K.DELETE)
+            if typed:
+                box.send_keys(typed)
+            box.send_keys(K.TAB)
             t = js(driver, "return window.rcb4Studio.editor.doc.steps[1].time_ms")
             check(t == 400, f"pose time {typed!r}: refused or ignored, the pose keeps 400 ms ({t}, {message(driver)!r})")
+        check("multiple of 10" in message(driver), f"1005 ms: the board's 10 ms period named ({message(driver)!r})")
         # Undo covers a slider drag as one step (issue 41, M1): the motion as it was before the drag.
         depth = js(driver, "return window.rcb4Studio.editor.history.undo")
         js(driver, """const s = document.querySelector('.pose-joint[data-joint="head_yaw"] input[type=range]');
@@ -311,14 +336,35 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
                          and not js(driver, "return window.rcb4State.motion.running"), timeout=10),
               f"and it ends at its last pose ({measured(driver, 'left_knee')})")
         shot(driver, "rcb4-studio-buttons.png")
+        # Free all asks first (every servo limp: a standing robot falls); No frees nothing.
+        modes = lambda: js(driver, "return window.rcb4State.modes")  # noqa: E731
+        js(driver, "window.confirm = () => false")
+        click(driver, "id", "free-all")
+        time.sleep(0.6)  # three board periods and more: a free sent would show
+        check("free" not in modes() and "cancelled" in message(driver),
+              f"Free all, answered No: no servo freed ({modes()}, {message(driver)!r})")
+        js(driver, "window.confirm = () => true")
+        click(driver, "id", "free-all")
+        check(wait_until(lambda: set(modes()) == {"free"}, timeout=10), f"Free all, answered Yes: every servo free ({modes()})")
+        click(driver, "id", "hold-all")
+        check(wait_until(lambda: "free" not in modes(), timeout=10), f"and Hold all holds them ({modes()})")
         # Trims: set live, then kept in ROM.
         click(driver, "css", "#trims-panel summary")
         wait_until(lambda: driver.find_elements(By.CSS_SELECTOR, '#trims input[data-joint="left_knee"]'), timeout=10)
+        ram_trim = ("window.rcb4Studio.request({op: 'trims'}).then((r) => arguments[0]("
+                    "r.trims.find((t) => t.name === 'left_knee').degrees), (e) => arguments[0]('ERROR ' + e.message))")
+        before = driver.execute_async_script(ram_trim)
+        for text in ("12x", "4,5"):  # typed: a browser's number box wrote 12 (and 45) into the servo's RAM
+            box = driver.find_element(By.CSS_SELECTOR, '#trims input[data-joint="left_knee"]')
+            box.send_keys(K.CONTROL, "a")
+            box.send_keys(text, K.TAB)
+            check("is not a number" in message(driver) and driver.execute_async_script(ram_trim) == before,
+                  f"{text!r} as a trim: refused, the board's trim unchanged ({before}; {message(driver)!r})")
         js(driver, """const n = document.querySelector('#trims input[data-joint="left_knee"]');
                       n.value = 1.5; n.dispatchEvent(new Event('change'));""")
         check(wait_until(lambda: "left_knee trim 1.5" in message(driver), timeout=10), f"a trim set live ({message(driver)!r})")
         click(driver, "id", "trims-persist")
-        check(wait_until(lambda: "kept in ROM" in message(driver), timeout=10), f"and kept in ROM ({message(driver)!r})")
+        check(wait_until(lambda: "trims kept in ROM" in message(driver), timeout=10), f"and kept in ROM ({message(driver)!r})")
         # A motion saved as the YAML file the tool reads.
         yaml_text = driver.execute_async_script(
             "window.rcb4Studio.request({op: 'motion_check', text: JSON.stringify(window.rcb4Studio.editor.doc)})"

@@ -104,10 +104,12 @@ inline std::vector<std::uint8_t> default_rom() {
               {10, {{5, 10300}}},
               {10, {{5, 9000}}},
               {20, {{3, 7500}, {5, 7500}}}});
-  // Bow: both hips' pitch (ICS 14, 15) forward by 33.75°, the knees (16, 17) bent 16.9° to balance.
+  // Bow: both hips' pitch (ICS 14, 15) +33.75°, the knees (16, 17) +16.9°, the same on both sides
+  // in the built-in profile's degrees, so the 3D view, balance and Mirror see a symmetric bow
+  // (docs/browser.md, "Mirror and a real robot": the profile's senses are unchecked on a real robot).
   put_motion(rom, l, 3,
-             {{25, {{14, 8500}, {15, 6500}, {16, 8000}, {17, 7000}}},
-              {15, {{14, 8500}, {15, 6500}}},
+             {{25, {{14, 8500}, {15, 8500}, {16, 8000}, {17, 8000}}},
+              {15, {{14, 8500}, {15, 8500}}},
               {25, {{14, 7500}, {15, 7500}, {16, 7500}, {17, 7500}}}});
   return rom;
 }
