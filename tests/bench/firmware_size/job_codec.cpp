@@ -1,0 +1,54 @@
+// The firmware-size bench's job, written with the codec's command types as a firmware author
+// would from docs/codec.md: ping, read the config word and 20 servo positions, move 2 servos with
+// one CONST. Every reply is checked (its size, checksum, kind and length: parse_reply with the
+// command's expected shape); a reply that does not come within 100 ms fails the job.
+// SPDX-License-Identifier: BSL-1.0
+#include <rcb4/rcb4.hpp>
+
+#include "uart.hpp"
+
+#include <array>
+
+namespace {
+
+std::array<std::uint8_t, rcb4::max_reply_size> g_rx{};  // the reply (a data reply refers to it)
+
+/** Sends @p c and reads its reply: the reply when it came whole and valid, else the error. */
+template <rcb4::Command C>
+rcb4::result<rcb4::reply> exchange(const C& c) noexcept {
+  std::array<std::uint8_t, rcb4::max_request_size> tx{};
+  const auto n = rcb4::serialize(c, tx);
+  if (!n) return n.error();
+  for (std::size_t i = 0; i < *n; ++i) bench::uart_put(tx[i]);
+  const std::uint32_t deadline = bench::now_ms() + 100;
+  std::size_t got = 0;
+  for (;;) {
+    const auto p = rcb4::parse_reply({g_rx.data(), got}, c.expected_reply());
+    if (p.ok()) return p.value();
+    if (p.status == rcb4::parse_status::error) return p.error;
+    for (std::size_t k = 0; k < p.needed; ++k) {
+      const int b = bench::uart_get(deadline);
+      if (b < 0) return rcb4::errc::link_timeout;
+      g_rx[got++] = static_cast<std::uint8_t>(b);
+    }
+  }
+}
+
+}  // namespace
+
+int main() {
+  using namespace rcb4;
+  if (auto r = exchange(ping{}); !r || !r->is_ack()) bench::finish(1);
+  const auto config = exchange(move::read_ram(ram::config, 2).value());
+  if (!config || config->bytes().size() != 2) bench::finish(2);
+  std::uint32_t sum = config->bytes()[0];
+  for (unsigned i = 0; i < 20; ++i) {
+    const auto at = move::read_ics(ics_number::make(i).value(), servo_block::position.offset, 2).value();
+    const auto r = exchange(at);
+    if (!r || r->bytes().size() != 2) bench::finish(3);
+    sum += static_cast<std::uint32_t>(r->bytes()[0] | r->bytes()[1] << 8);
+  }
+  servo_set<servo_position> two{{ics_number{1}, servo_position{8000}}, {ics_number{3}, servo_position{7000}}};
+  if (auto r = exchange(const_servo::make(two, frames{20}).value()); !r || !r->is_ack()) bench::finish(4);
+  bench::finish(sum == 0 ? 5 : 0);
+}
