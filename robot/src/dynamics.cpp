@@ -92,6 +92,12 @@ dynamics parse_dynamics(const std::string& source, const YAML::Node& n, const ki
     at_least_0("armature", d.joints.armature);
     at_least_0("friction", d.joints.friction);
   }
+  // Every link of the body weighs something: one left out would be massless, silently.
+  for (const auto& l : body.links)
+    if (!d.find(l.name))
+      fail(source, ls,
+           "dynamics: links: " + l.name +
+               ": no mass given (every link of the body needs its mass, centre of mass and inertia)");
   if (const auto problem = check_dynamics(d, body)) fail(source, n, "dynamics: " + *problem);
   return d;
 }

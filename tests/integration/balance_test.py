@@ -103,6 +103,15 @@ check(rc == 2 and "missing.yaml" in err, f"no such file: exit 2 naming it ({rc}:
 rc, out, err = run("motion", "check", "bare_motion.yaml")
 check(rc == 2 and "bare" in err, f"a motion of another robot: exit 2 ({rc}: {err[-200:]!r})")
 
+# --json urdf: one JSON object (the URDF text in it), as every command's --json gives.
+rc, out, err = run("--json", "urdf")
+try:
+    j = json.loads(out)
+except ValueError:
+    j = {}
+check(rc == 0 and j.get("robot") == "KHR-3HV" and str(j.get("urdf", "")).lstrip().startswith("<?xml")
+      and "<inertial>" in j.get("urdf", ""), f"--json urdf: a JSON object holding the URDF ({rc}: {out[:120]!r})")
+
 # The mass model in URDF: one <inertial> per link, 1.458 kg in all.
 rc, out, err = run("urdf")
 masses = [float(x.split('"')[1]) for x in out.split("<mass value=")[1:]]

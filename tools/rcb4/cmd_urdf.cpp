@@ -23,6 +23,10 @@ void add_urdf_command(CLI::App& app, context& ctx) {
       throw failure(exit_usage, e.what(),
                     "a profile's kinematics: section describes its body (docs/robot-profiles.md)");
     }
+    if (ctx.g.json) {  // one JSON object as every command's --json: the URDF text in it, not XML bare
+      emit(json{{"robot", m.name()}, {"prefix", *prefix}, {"urdf", text}});
+      return exit_ok;
+    }
     fmt::print("{}", text);
     return exit_ok;
   });

@@ -127,6 +127,10 @@ inline std::optional<std::string> check_dynamics(const dynamics& d, const kinema
     if (!k.find_link(l.link)) return l.link + ": no link of the kinematics is called so";
     if (auto p = inertial_problem(l.whole)) return l.link + ": " + *p;
   }
+  // A link left out would weigh nothing, silently: balance and physics would be wrong without a word.
+  for (const auto& l : k.links)
+    if (!d.find(l.name))
+      return l.name + ": no mass given (every link of the body needs its mass, centre of mass and inertia)";
   if (d.soles.empty()) return "soles: at least one sole is needed (the boxes the robot stands on)";
   for (const auto& s : d.soles) {
     if (!k.find_link(s.link)) return "soles: " + s.link + ": no link of the kinematics is called so";

@@ -97,6 +97,10 @@ TEST_CASE("dynamics: each mistake with its line", "[profile][dynamics]") {
   CHECK_THAT(error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n"
                              "  soles:\n    leg: {box: [1, 0, 1]}\n"),
              Contains("more than 0 mm"));
+  // A link of the body left out of links: named, never weighed as nothing.
+  CHECK_THAT(
+      error_of(body + "dynamics:\n  links:\n    body: {mass: 5, com: [0, 0, 0], inertia: [1, 1, 1]}\n" + ok_soles),
+      Contains(":12:") && Contains("leg: no mass given"));
   CHECK_THAT(error_of("robot: t\njoints:\n  hip: {ics: 1, lower: -90, upper: 90}\n"
                       "dynamics:\n  links: {}\n"),
              Contains(":5:") && Contains("needs the body"));
