@@ -58,6 +58,15 @@ function connect() {
   };
 }
 
+/**
+ * A free, hold or motion stop stops what plays first (its next pose would power or move the joints
+ * again): the words for it, and the editor told that its play from the host has ended.
+ */
+function stoppedFirst(m) {
+  if (m.play_stopped) ui.studio?.editor.played({ error: 'stopped by the free, hold or Stop motion' });
+  return m.play_stopped || m.motion_stopped ? 'the motion playing was stopped first; ' : '';
+}
+
 function send(msg) {
   if (ui.ws?.readyState !== WebSocket.OPEN) return null;
   msg.id ??= ui.nextId++;
@@ -115,10 +124,10 @@ const on = {
       play_pose: () => `playing ${m.name} over ${m.ms} ms`,
       motion_play: () => `playing motion ${m.slot}`,
       motion_file: () => showMotionFile(m),
-      motion_stop: () => 'motion stopped',
+      motion_stop: () => { stoppedFirst(m); return 'motion stopped' + (m.play_stopped ? ' (and the play from the host)' : ''); },
       stop: () => 'stopped: every joint holds where it is',
-      free: () => `${m.joints} joints free` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
-      hold: () => `${m.joints} joints holding` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
+      free: () => stoppedFirst(m) + `${m.joints} joints free` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
+      hold: () => stoppedFirst(m) + `${m.joints} joints holding` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
       control: () => 'this page controls the robot',
       release: () => 'control released',
     }[m.op];
@@ -288,7 +297,8 @@ function setRole(role, controlled) {
   // A watching page says why its controls are off, where they are.
   const note = $('#role-note');
   note.hidden = role === 'control';
-  note.textContent = controlled ? 'Another page controls the robot: this one watches, so its controls are off until that page releases control or closes.'
+  note.textContent = ui.ws?.readyState !== WebSocket.OPEN ? 'No connection to rcb4 ui: nothing on this page reaches the robot until it is back (the header says more).'
+    : controlled ? 'Another page controls the robot: this one watches, so its controls are off until that page releases control or closes.'
     : 'This page watches: Take control to move the robot, edit trims and buttons, or write motions.';
 }
 
@@ -318,10 +328,11 @@ async function insertPose(name) {
 
 function playPose(name) {
   // the time the pose is played over: checked, never coerced (letters are no 0 ms snap)
-  // (the server turns it into the board's frames, and stretches it to the speed limit)
-  const most = ui.hello?.max_move_ms ?? 6375;
-  const r = numberIn($('#pose-ms'), { min: 10, max: most, whole: true, what: 'play over', unit: ' ms' });
-  if (r.value === null) return say(r.why || `play over: type a time in ms (10 to ${most})`, 'error');
+  // whole periods of the board's output period (the state says it), 255 of them at most; the
+  // server stretches it to the speed limit
+  const period = ui.lastState?.output_period_ms || 10, most = 255 * period;
+  const r = numberIn($('#pose-ms'), { min: period, max: most, whole: true, multipleOf: period, what: 'play over', unit: ' ms' });
+  if (r.value === null) return say(r.why || `play over: type a time in ms (${period} to ${most})`, 'error');
   send({ op: 'play_pose', name, ms: r.value });
 }
 
@@ -453,7 +464,15 @@ function wire() {
   $('#hold-all').addEventListener('click', () => send({ op: 'hold', joints: ['all'] }));
   $('#stop').addEventListener('click', () => send({ op: 'stop' }));
   $('#motion-stop').addEventListener('click', () => send({ op: 'motion_stop' }));
-  $('#motions-resume').addEventListener('click', () => request({ op: 'motion_resume' }).then(() => say('the ROM program runs again'), (e) => say(e.message, 'error')));
+  // Resume runs the ROM program on from where it stopped: a motion stopped part way goes on, and
+  // the robot moves. Asked first then (a user who wants the buttons back may not expect it).
+  $('#motions-resume').addEventListener('click', () => {
+    const mo = ui.lastState?.motion;
+    if (mo?.suspended && mo.slot && !window.confirm(`Motion ${mo.slot} was stopped part way: Resume runs it on from where it stopped, and the robot moves. Resume it?`))
+      return say('resume cancelled: the ROM program stays stopped');
+    request({ op: 'motion_resume' }).then(() => say(mo?.suspended && mo.slot ? `motion ${mo.slot} runs on from where it stopped` : 'the ROM program runs again'),
+      (e) => say(e.message, 'error'));
+  });
   $('#refresh').addEventListener('click', () => send({ op: 'refresh' }));
   $('#capture-form').addEventListener('submit', (ev) => {
     ev.preventDefault();

@@ -37,20 +37,32 @@ export function numberIn(input, check = input.numberCheck ?? {}) {
     input.setAttribute('aria-invalid', 'true');
     return { value: null, why };
   };
+  const unmark = () => {
+    input.classList.remove('invalid');
+    input.title = input.numberCheck?.min !== undefined ? `${min} to ${max}${unit}` : '';
+    input.setCustomValidity?.('');
+    input.removeAttribute('aria-invalid');
+  };
   const text = String(input.value ?? '').trim();
   if (input.validity?.badInput) return mark(`${what}: not a number: nothing changed`);
-  if (text === '') return { value: null, why: null, empty: true };
-  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(text)) return mark(`${what}: '${text}' is not a number: nothing changed`);
+  if (text === '') {  // nothing to change: the caller puts the kept value back, unmarked
+    unmark();
+    return { value: null, why: null, empty: true };
+  }
+  // Plain decimals only: an exponent (1e1) or a comma is far likelier a typo than a number meant,
+  // and a whole number is digits alone (10.0 is no slot).
+  if (whole ? !/^[+-]?\d+$/.test(text) && /^[+-]?(\d+\.\d*|\.\d+)$/.test(text) : false)
+    return mark(`${what}: ${text} is not a whole number: nothing changed`);
+  if (!(whole ? /^[+-]?\d+$/ : /^[+-]?(\d+\.?\d*|\.\d+)$/).test(text)) return mark(`${what}: '${text}' is not a number: nothing changed`);
   const v = Number(text);
   if (!Number.isFinite(v)) return mark(`${what}: '${text}' is not a number: nothing changed`);
-  if (whole && !Number.isInteger(v)) return mark(`${what}: ${text} is not a whole number: nothing changed`);
   if (v < min || v > max) return mark(`${what}: ${text}${unit} is outside ${min}..${max}${unit}: nothing changed`);
   if (multipleOf && Math.abs(v / multipleOf - Math.round(v / multipleOf)) > 1e-9)
     return mark(`${what}: ${text}${unit} is not a multiple of ${multipleOf}${unit} (the board counts in steps of ${multipleOf}${unit}): nothing changed`);
-  input.classList.remove('invalid');
-  input.title = '';
-  input.setCustomValidity?.('');
-  input.removeAttribute('aria-invalid');
+  unmark();
+  // A message still saying this box was refused is stale once it holds a good value.
+  const banner = document.querySelector('#message.error');
+  if (banner && banner.textContent.startsWith(`${what}: `)) { banner.className = 'message'; banner.textContent = ''; }
   return { value: v, why: null };
 }
 

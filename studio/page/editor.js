@@ -84,7 +84,7 @@ export function createEditor(root, ctx) {
   const bt = (id, text, title, fn, cls = '') => el('button', { id, type: 'button', title, class: cls, onclick: fn }, text);
   root.replaceChildren(
     el('div', { class: 'row' }, name,
-      bt('ed-new', 'New', 'an empty motion', () => { if (mayReplace('New')) { load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] }); markClean(); } }),
+      bt('ed-new', 'New', 'an empty motion', () => { if (mayReplace('New')) { const note = load({ robot: h.robot, name: '', period_ms: 10, steps: ['end'] }); markClean(); if (note) ctx.say('a new motion' + note); } }),
       bt('ed-open', 'Open…', 'a motion file (.yaml) from this computer, or a slot\'s .bin backup to put back into the slot', () => file.click()), file,
       bt('ed-save', 'Save', 'download the motion as a motion file (.yaml), as rcb4 motion push reads it', save)),
     el('div', { class: 'row' }, 'slot', slot,
@@ -243,8 +243,11 @@ export function createEditor(root, ctx) {
     const wasLive = ed.live;
     ed.live = false;
     ed.liveSent = null;
+    const before = snapshot();
     reshape((p) => mirrorPose(h, p, which));
-    if (wasLive) ctx.say('mirrored; live is now off, so the robot did not move: look at the pose in the 3D view, then tick live to send it');
+    if (snapshot() === before) return;  // refused (said) or nothing to mirror
+    ctx.say(wasLive ? 'mirrored; live is now off, so the robot did not move: look at the pose in the 3D view, then tick live to send it'
+      : 'mirrored (the robot did not move: live is off)');
   }
   function home() {  // every joint of the pose at 0°, the robot's home with its trims
     reshape((pose) => {
@@ -370,6 +373,8 @@ export function createEditor(root, ctx) {
           }
         });
       });
+      // Enter in a box of the form applies it, as in a pose's boxes.
+      form.el.addEventListener('keydown', (e) => { if (e.key === 'Enter' && e.target.matches('input')) { e.preventDefault(); apply.click(); } });
       detail.replaceChildren(el('div', { class: 'small muted', text: `step ${ed.sel + 1}: ${describe(s)}` }), form.el, el('div', { class: 'row' }, apply));
       return;
     }
@@ -475,21 +480,27 @@ export function createEditor(root, ctx) {
   const text = () => JSON.stringify({ ...ed.doc, steps: toFile(ed.doc), flow: undefined, name: name.value.trim() || undefined, robot: h.robot });
   name.addEventListener('change', () => change(() => { ed.doc.name = name.value.trim(); }));
   function load(doc) {
+    // A motion loaded (New, Pull, Open…) is no move asked for: live goes off, the robot stays. The
+    // words for it are returned, for the caller's message.
+    const wasLive = ed.live;
+    ed.live = false;
+    ed.liveSent = null;
     ed.undo.push(snapshot());
     ed.redo = [];  // what was undone before belongs to the motion replaced
     const opened = fromFile(doc.steps?.length ? doc.steps : ['end']);
     ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: opened.steps, flow: opened.flow };
     ed.sel = 0;
     render();
+    return wasLive ? '; live is now off, so the robot did not move (tick live to send the selected pose)' : '';
   }
   async function pull() {
     try {
       const n = slotIn(); if (n === null) return;
       if (!mayReplace(`Pulling slot ${n}`)) return ctx.say('pull cancelled: the motion in the editor is kept');
       const r = await ctx.request({ op: 'motion_pull', slot: n });
-      load(r.motion);
+      const note = load(r.motion);
       markClean();
-      ctx.say(`motion ${r.slot} in the editor (${r.plays})` + (r.problem ? `; as it is, it would not push back: ${r.problem}` : ''));
+      ctx.say(`motion ${r.slot} in the editor (${r.plays})` + (r.problem ? `; as it is, it would not push back: ${r.problem}` : '') + note);
     } catch (e) { ctx.say(e.message, 'error'); }
   }
   async function push() {
@@ -534,9 +545,9 @@ export function createEditor(root, ctx) {
     if (!mayReplace(`Opening ${f.name}`)) return ctx.say('open cancelled: the motion in the editor is kept');
     try {
       const r = await ctx.request({ op: 'motion_check', text: await f.text() });
-      load(r.motion);
+      const note = load(r.motion);
       markClean();
-      ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}`, r.problem ? 'error' : 'note');
+      ctx.say(`${f.name}: ${r.problem ? 'opened; as it is it would not play: ' + r.problem : 'opened'}${note}`, r.problem ? 'error' : 'note');
     } catch (e) { ctx.say(`${f.name}: ${e.message}`, 'error'); }
   });
 
@@ -564,6 +575,17 @@ export function createEditor(root, ctx) {
   summary.after(balanceLine);
   balance = createBalance(ctx, text, balanceLine, [steps, timeline]);
   root.append(el('div', { id: 'ed-result', class: 'small muted' }));
+  // Ctrl+Z / Ctrl+Y right after typing a value, in its box, as HTH4 users do: the box's value is
+  // taken first (as leaving it would), then the motion's undo or redo; the browser's own text undo
+  // would only change the box.
+  root.addEventListener('keydown', (e) => {
+    if (!(e.ctrlKey || e.metaKey) || !e.target.matches?.('input.num')) return;
+    const k = e.key.toLowerCase();
+    if (k !== 'z' && k !== 'y') return;
+    e.preventDefault();
+    e.target.blur();
+    if (k === 'y' || e.shiftKey) redo(); else undo();
+  });
 
   render();
   return {
@@ -586,6 +608,8 @@ export function createEditor(root, ctx) {
     get previewFrom() { return ed.previewFrom ?? null; },
     /** The undo and redo depths, and whether the motion has unsaved changes (tests). */
     get history() { return { undo: ed.undo.length, redo: ed.redo.length, dirty: dirty() }; },
+    /** True while a motion plays from the host (tests). */
+    get playing() { return !!ed.playing; },
     /** A motion played from the host ended (the server's "played"). */
     played(m) { ed.playing = false; ctx.say(m.error ? `the play stopped: ${m.error}` : `played ${m.poses} poses in ${m.seconds} s`, m.error ? 'error' : 'note'); },
     stop,

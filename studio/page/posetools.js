@@ -39,7 +39,7 @@ const clipKey = (robot) => `rcb4-studio-clipboard:${robot}`;
 /** Keeps @p step (a pose step) where every tab of this robot finds it. Returns an error text or null. */
 export function copyPose(robot, step) {
   try {
-    localStorage.setItem(clipKey(robot), JSON.stringify({ pose: step.pose, time_ms: step.time_ms }));
+    localStorage.setItem(clipKey(robot), JSON.stringify({ pose: step.pose, time_ms: step.time_ms, name: step.name }));
     return null;
   } catch (e) {
     return `the browser would not keep the pose (${e.name})`;
@@ -60,5 +60,7 @@ export function pastedPose(hello) {
       return { why: `the copied pose's ${n} (${a}) is beyond its limits ${lim.lower}..${lim.upper}` };
     pose[n] = a;
   }
-  return { step: { pose, time_ms: Number.isInteger(v.time_ms) && v.time_ms > 0 ? v.time_ms : 500 } };
+  const step = { pose, time_ms: Number.isInteger(v.time_ms) && v.time_ms > 0 ? v.time_ms : 500 };
+  if (typeof v.name === 'string' && v.name.trim() && v.name.length <= 80) step.name = v.name;  // its name comes with it
+  return { step };
 }

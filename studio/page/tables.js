@@ -109,6 +109,7 @@ export function createTables(root, ctx) {
   const readButtons = () => ask({ op: 'buttons' }, null, showEntries);
 
   // --- trims ---
+  let trimSeq = 0;  // the latest trim action: an older one's answer does not say over a newer one's
   async function readTrims() {
     if (!trims.children.length) trims.replaceChildren(el('div', { class: 'small muted', text: 'reading the trims…' }));
     const r = await ask({ op: 'trims' });
@@ -125,10 +126,11 @@ export function createTables(root, ctx) {
         }
         // read back at once: the row says what RAM and ROM hold now (never "in ROM" for a RAM change),
         // and the message what the board made of the degrees typed (it holds whole counts of a servo step)
+        const mine = ++trimSeq;
         ask({ op: 'trim_set', joints: { [t.name]: typed.value } }).then(async (ok) => {
           if (!ok) return;
           const now = (await readTrims())?.find((x) => x.name === t.name);
-          ctx.say(`${t.name} trim ${typed.value}° (RAM, not kept in ROM)` + (now
+          if (mine === trimSeq) ctx.say(`${t.name} trim ${typed.value}° (RAM, not kept in ROM)` + (now
             ? `: the board holds ${now.counts} counts, ${Math.round(now.exact_degrees * 1000) / 1000}°` : ''));
         });
       });
@@ -140,6 +142,7 @@ export function createTables(root, ctx) {
     return r.trims;
   }
   persist.addEventListener('click', async () => {
+    ++trimSeq;  // a RAM write still answering (a box left by this click) says nothing over this one
     const joints = {};
     for (const n of trims.querySelectorAll('input[data-joint]')) {
       // every box must hold a trim: one that does not stops the whole write (nothing is kept in ROM)

@@ -55,12 +55,40 @@ rcb4::servo_mask board_loop::mask_of(const std::vector<const robot::joint*>& joi
   return mask;
 }
 
+json board_loop::stop_motions_first() {
+  json out = json::object();
+  if (studio_.playing()) {
+    try {
+      studio_.stop();
+    } catch (const std::exception&) {  // the board may not answer: the motion stop below is tried anyway
+    }
+    out["play_stopped"] = true;
+  }
+  bool running = true;
+  try {
+    const auto st = must(ops::read_motion_state(*o_.layout), "read the motion state");
+    running = st.running && st.motion;
+  } catch (const refusal&) {
+    // Unknown: stop it anyway.
+  }
+  if (running) {
+    insist([] { return ops::stop_motion{}; }, "stop the motion");
+    out["motion_stopped"] = true;
+  }
+  return out;
+}
+
 json board_loop::act(const power_action& a) {
   std::vector<std::string> missing;
   const auto mask = mask_of(a.joints, &missing);
   if (mask.empty()) throw refusal{"none of these joints has a servo block on the board (see rcb4 scan)"};
+  // A motion's next pose would power the joints again (a free robot jerked back mid-fall), or move
+  // held ones on: whatever plays stops first, and the answer says so.
+  json out = stop_motions_first();
   must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask), a.free ? "free" : "hold");
-  return json{{"joints", a.joints.size() - missing.size()}, {"missing", missing}};
+  out["joints"] = a.joints.size() - missing.size();
+  out["missing"] = missing;
+  return out;
 }
 
 json board_loop::act(const stop_action& a) {
@@ -170,6 +198,9 @@ json board_loop::act(const play_pose_action& a) {
   if (time > slowest())
     throw refusal{fmt::format("a move takes at most 255 output periods: {} ms at this board's {} ms period, not {} ms",
                               slowest().count(), rcb4::milliseconds(period_), time.count())};
+  if (a.ms && *a.ms % static_cast<int>(rcb4::milliseconds(period_)) != 0)  // asked for: refused, never rounded
+    throw refusal{fmt::format("{} ms is not a whole number of this board's {} ms output periods", *a.ms,
+                              rcb4::milliseconds(period_))};
   time = std::max(time, paced_time(span, h_.limits()));
   std::vector<robot::joint_target> targets;
   for (const auto& [name, d] : p.joints) targets.push_back({name, d, time});
@@ -184,8 +215,16 @@ json board_loop::act(const motion_play_action& a) {
 }
 
 json board_loop::act(const motion_stop_action&) {
+  json out = json::object();
+  if (studio_.playing()) {  // a motion played from the host is a motion too: Stop motion stops it
+    try {
+      studio_.stop();
+    } catch (const std::exception&) {  // the board may not answer: the ROM's motion is stopped anyway
+    }
+    out["play_stopped"] = true;
+  }
   must(ops::stop_motion{}, "stop the motion");
-  return nullptr;
+  return out;
 }
 
 json board_loop::act(const refresh_action&) {

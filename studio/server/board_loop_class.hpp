@@ -100,6 +100,8 @@ class board_loop {
   rcb4::servo_mask mask_of(const std::vector<const joint*>& joints, std::vector<std::string>* missing);
   std::filesystem::path pose_path(const std::string& name, bool for_reading) const;
   json act(const power_action& a);
+  /** Stops a motion playing from the host and one of the ROM's, if any: what a free or hold needs first. */
+  json stop_motions_first();
   json act(const stop_action& a);
   json act(const capture_action& a);
   json act(const play_pose_action& a);

@@ -93,6 +93,7 @@ std::string board_loop::state_text() {
   j["angles"] = std::move(a);
   j["targets"] = std::move(g);
   j["modes"] = std::move(md);
+  j["output_period_ms"] = rcb4::milliseconds(period_);  // the board's: a move's time is whole periods of it
   if (answering_) {
     j["battery"] = std::round(analog_.battery_volts * 100) / 100;
     json ad = json::array();
