@@ -124,7 +124,7 @@ const on = {
       play_pose: () => `playing ${m.name} over ${m.ms} ms`,
       motion_play: () => `playing motion ${m.slot}`,
       motion_file: () => showMotionFile(m),
-      motion_stop: () => { stoppedFirst(m); return 'motion stopped' + (m.play_stopped ? ' (and the play from the host)' : ''); },
+      motion_stop: () => { stoppedFirst(m); return 'motion stopped' + (m.play_stopped ? ' (and the play from the host)' : '') + ': every joint holds where it is'; },
       stop: () => 'stopped: every joint holds where it is',
       free: () => stoppedFirst(m) + `${m.joints} joints free` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
       hold: () => stoppedFirst(m) + `${m.joints} joints holding` + (m.missing?.length ? ` (no servo: ${m.missing.join(', ')})` : ''),
@@ -330,8 +330,9 @@ function playPose(name) {
   // the time the pose is played over: checked, never coerced (letters are no 0 ms snap)
   // whole periods of the board's output period (the state says it), 255 of them at most; the
   // server stretches it to the speed limit
-  const period = ui.lastState?.output_period_ms || 10, most = 255 * period;
-  const r = numberIn($('#pose-ms'), { min: period, max: most, whole: true, multipleOf: period, what: 'play over', unit: ' ms' });
+  const box = $('#pose-ms'), period = ui.lastState?.output_period_ms || 10, most = 255 * period;
+  box.numberCheck = { min: period, max: most, whole: true, multipleOf: period, what: 'play over', unit: ' ms' };
+  const r = numberIn(box);
   if (r.value === null) return say(r.why || `play over: type a time in ms (${period} to ${most})`, 'error');
   send({ op: 'play_pose', name, ms: r.value });
 }
@@ -467,8 +468,10 @@ function wire() {
   // Resume runs the ROM program on from where it stopped: a motion stopped part way goes on, and
   // the robot moves. Asked first then (a user who wants the buttons back may not expect it).
   $('#motions-resume').addEventListener('click', () => {
-    const mo = ui.lastState?.motion;
-    if (mo?.suspended && mo.slot && !window.confirm(`Motion ${mo.slot} was stopped part way: Resume runs it on from where it stopped, and the robot moves. Resume it?`))
+    const mo = ui.lastState?.motion, free = (ui.lastState?.modes ?? []).filter((x) => x === 'free').length;
+    if (mo?.suspended && mo.slot && !window.confirm(`Motion ${mo.slot} of the ROM (its slot, not a play from the editor) was stopped part way: `
+      + 'Resume runs it on from where it stopped (the pose that was under way is not played again), and the robot moves'
+      + (free ? `; the ${free} servos that are free now are powered again by its next pose` : '') + '. Resume it?'))
       return say('resume cancelled: the ROM program stays stopped');
     request({ op: 'motion_resume' }).then(() => say(mo?.suspended && mo.slot ? `motion ${mo.slot} runs on from where it stopped` : 'the ROM program runs again'),
       (e) => say(e.message, 'error'));
@@ -487,8 +490,29 @@ function wire() {
 }
 
 wire();
-// The robot's panel sticks below the header (style.css), whose height depends on the window.
-const headerHeight = () => document.documentElement.style.setProperty('--header-h', `${$('header').offsetHeight}px`);
+// "play over" is marked or cleared as typed, like every number box (its check: playPose()).
+$('#pose-ms').numberCheck = { min: 10, max: 2550, whole: true, multipleOf: 10, what: 'play over', unit: ' ms' };
+$('#pose-ms').addEventListener('input', (e) => numberIn(e.target));
+
+// The robot's panel sticks below the header (style.css), whose height depends on the window. What
+// is scrolled to (a focused box, a selected step) lands below both, never under the robot's panel.
+const headerHeight = () => {
+  const root = document.documentElement, head = $('header').offsetHeight;
+  root.style.setProperty('--header-h', `${head}px`);
+  const panel = document.querySelector('.studio > .panel:first-child');
+  const pinned = !document.querySelector('.studio').classList.contains('unpinned');
+  root.style.scrollPaddingTop = `${head + (pinned && panel ? panel.offsetHeight : 0) + 8}px`;
+};
+// The robot kept in view (the default), or scrolled away with the page (this browser remembers).
+const pin = $('#pin-robot');
+try { pin.checked = localStorage.getItem('rcb4-studio-unpinned') !== '1'; } catch { /* no storage: pinned */ }
+const pinned = () => {
+  document.querySelector('.studio').classList.toggle('unpinned', !pin.checked);
+  try { localStorage.setItem('rcb4-studio-unpinned', pin.checked ? '0' : '1'); } catch { /* not kept */ }
+  headerHeight();
+};
+pin.addEventListener('change', pinned);
 window.addEventListener('resize', headerHeight);
-headerHeight();
+new ResizeObserver(headerHeight).observe(document.querySelector('.studio > .panel:first-child'));
+pinned();
 connect();

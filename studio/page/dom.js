@@ -45,24 +45,28 @@ export function numberIn(input, check = input.numberCheck ?? {}) {
   };
   const text = String(input.value ?? '').trim();
   if (input.validity?.badInput) return mark(`${what}: not a number: nothing changed`);
+  // A message still saying this box was refused is stale once the box is emptied or good.
+  const clearStale = () => {
+    const banner = document.querySelector('#message.error');
+    if (banner && banner.textContent.startsWith(`${what}: `)) { banner.className = 'message'; banner.textContent = ''; }
+  };
   if (text === '') {  // nothing to change: the caller puts the kept value back, unmarked
     unmark();
+    clearStale();
     return { value: null, why: null, empty: true };
   }
   // Plain decimals only: an exponent (1e1) or a comma is far likelier a typo than a number meant,
   // and a whole number is digits alone (10.0 is no slot).
-  if (whole ? !/^[+-]?\d+$/.test(text) && /^[+-]?(\d+\.\d*|\.\d+)$/.test(text) : false)
-    return mark(`${what}: ${text} is not a whole number: nothing changed`);
-  if (!(whole ? /^[+-]?\d+$/ : /^[+-]?(\d+\.?\d*|\.\d+)$/).test(text)) return mark(`${what}: '${text}' is not a number: nothing changed`);
+  if (whole && /^[+-]?(\d+\.\d*|\.\d+)$/.test(text)) return mark(`${what}: ${text} is not a whole number: nothing changed`);
+  if (whole && /^[+-]\d+$/.test(text)) return mark(`${what}: ${text}: digits only, no sign: nothing changed`);
+  if (!(whole ? /^\d+$/ : /^[+-]?(\d+\.?\d*|\.\d+)$/).test(text)) return mark(`${what}: '${text}' is not a number: nothing changed`);
   const v = Number(text);
   if (!Number.isFinite(v)) return mark(`${what}: '${text}' is not a number: nothing changed`);
   if (v < min || v > max) return mark(`${what}: ${text}${unit} is outside ${min}..${max}${unit}: nothing changed`);
   if (multipleOf && Math.abs(v / multipleOf - Math.round(v / multipleOf)) > 1e-9)
     return mark(`${what}: ${text}${unit} is not a multiple of ${multipleOf}${unit} (the board counts in steps of ${multipleOf}${unit}): nothing changed`);
   unmark();
-  // A message still saying this box was refused is stale once it holds a good value.
-  const banner = document.querySelector('#message.error');
-  if (banner && banner.textContent.startsWith(`${what}: `)) { banner.className = 'message'; banner.textContent = ''; }
+  clearStale();
   return { value: v, why: null };
 }
 
@@ -79,7 +83,7 @@ export function numberBox(attrs = {}, check = {}) {
   input.numberCheck = check;
   if (check.min !== undefined && check.max !== undefined && !input.title)
     input.title = `${check.min} to ${check.max}${check.unit ?? ''}`;
-  input.addEventListener('input', () => { if (String(input.value).trim() !== '') numberIn(input); });
+  input.addEventListener('input', () => numberIn(input));  // marked or cleared as typed (emptied: unmarked)
   input.addEventListener('keydown', (e) => {
     if ((e.key !== 'ArrowUp' && e.key !== 'ArrowDown') || !check.step) return;
     const r = numberIn(input);

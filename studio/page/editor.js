@@ -110,16 +110,31 @@ export function createEditor(root, ctx) {
     el('div', { class: 'steps-box' }, jumps, steps));
 
   // --- history ---
-  const snapshot = () => JSON.stringify({ doc: ed.doc, sel: ed.sel });
-  const change = (fn) => {
-    ed.undo.push(snapshot());
+  // A quiet step of the history (a motion loaded, a mirror) never drives the robot: undone or
+  // redone with live ticked, it turns live off, as it did when it was made.
+  // (with the slot the motion came from: Push asks before it writes over any other slot)
+  const snapshot = (quiet = false) => JSON.stringify({ doc: ed.doc, sel: ed.sel, from: ed.from ?? null, ...(quiet ? { quiet: true } : {}) });
+  const change = (fn, quiet = false) => {
+    ed.undo.push(snapshot(quiet));
     if (ed.undo.length > 200) ed.undo.shift();
     ed.redo = [];
     fn();
     render();
   };
-  function undo() { if (!ed.undo.length) return; ed.redo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.undo.pop())); render(); }
-  function redo() { if (!ed.redo.length) return; ed.undo.push(snapshot()); ({ doc: ed.doc, sel: ed.sel } = JSON.parse(ed.redo.pop())); render(); }
+  const across = (from, to, what) => {
+    const e = JSON.parse(from.pop());
+    to.push(snapshot(!!e.quiet));
+    ({ doc: ed.doc, sel: ed.sel } = e);
+    ed.from = e.from ?? null;
+    if (e.quiet && ed.live) {
+      ed.live = false;
+      ed.liveSent = null;
+      ctx.say(`${what}: a motion loaded or a mirror, so live is now off and the robot did not move (tick live to send the pose)`);
+    }
+    render();
+  };
+  function undo() { if (ed.undo.length) across(ed.undo, ed.redo, 'undone'); }
+  function redo() { if (ed.redo.length) across(ed.redo, ed.undo, 'redone'); }
   const flow = createFlowchart(flowBox, { doc: () => ed.doc, sel: () => ed.sel, select: (i) => { ed.sel = i; render(); },
     change, kindOf, describe, say: ctx.say });
 
@@ -131,7 +146,7 @@ export function createEditor(root, ctx) {
   let kept = null;
   function keep() {
     try {
-      const text = JSON.stringify({ doc: ed.doc, sel: ed.sel, undo: ed.undo, redo: ed.redo, clean: ed.clean });
+      const text = JSON.stringify({ doc: ed.doc, sel: ed.sel, from: ed.from ?? null, undo: ed.undo, redo: ed.redo, clean: ed.clean });
       if (text === kept) return;  // unchanged: nothing to write
       sessionStorage.setItem(storeKey, text);
       kept = text;
@@ -147,6 +162,7 @@ export function createEditor(root, ctx) {
       if (!was || !was.doc || !Array.isArray(was.doc.steps) || !was.doc.steps.length) return;
       ed.doc = was.doc;
       ed.sel = Number.isInteger(was.sel) ? was.sel : 0;
+      ed.from = Number.isInteger(was.from) ? was.from : null;
       ed.undo = Array.isArray(was.undo) ? was.undo.filter((u) => typeof u === 'string') : [];
       ed.redo = Array.isArray(was.redo) ? was.redo.filter((u) => typeof u === 'string') : [];
       ed.clean = typeof was.clean === 'string' ? was.clean : null;
@@ -219,12 +235,12 @@ export function createEditor(root, ctx) {
     insert(r.step);
   }
   /** Replaces the selected pose's joints by @p fn(pose) → { pose } or { why }; live on the robot when ticked. */
-  function reshape(fn) {
+  function reshape(fn, quiet = false) {
     const s = ed.doc.steps[ed.sel];
     if (kindOf(s) !== 'pose') return;
     const r = fn(s.pose);
     if (!r.pose) return ctx.say(r.why, 'error');
-    change(() => { s.pose = r.pose; });  // live on the robot: render() sends the pose
+    change(() => { s.pose = r.pose; }, quiet);  // live on the robot: render() sends the pose
   }
   // Mirror's signs come from the profile's body (docs/browser.md, "Mirror and a real robot"): no
   // built-in body has been checked on a real robot, so the first mirror of a page asks, and a
@@ -244,7 +260,7 @@ export function createEditor(root, ctx) {
     ed.live = false;
     ed.liveSent = null;
     const before = snapshot();
-    reshape((p) => mirrorPose(h, p, which));
+    reshape((p) => mirrorPose(h, p, which), true);
     if (snapshot() === before) return;  // refused (said) or nothing to mirror
     ctx.say(wasLive ? 'mirrored; live is now off, so the robot did not move: look at the pose in the 3D view, then tick live to send it'
       : 'mirrored (the robot did not move: live is off)');
@@ -363,6 +379,7 @@ export function createEditor(root, ctx) {
       apply.addEventListener('click', () => {
         const r = form.read();
         if (!r.step) return ctx.say(`step ${ed.sel + 1}: ${r.why}` + (r.why.endsWith('nothing changed') ? '' : ': nothing changed'), 'error');
+        ctx.say(`step ${ed.sel + 1}: ${describe(r.step)}`);  // what was applied (a refusal said before is stale)
         change(() => {
           ed.doc.steps[ed.sel] = s?.name && r.step && typeof r.step === 'object' ? { ...r.step, name: s.name } : r.step;
           if (r.renamed) {  // a renamed label: the jumps to it follow
@@ -485,10 +502,11 @@ export function createEditor(root, ctx) {
     const wasLive = ed.live;
     ed.live = false;
     ed.liveSent = null;
-    ed.undo.push(snapshot());
+    ed.undo.push(snapshot(true));
     ed.redo = [];  // what was undone before belongs to the motion replaced
     const opened = fromFile(doc.steps?.length ? doc.steps : ['end']);
     ed.doc = { robot: doc.robot || h.robot, name: doc.name || '', period_ms: doc.period_ms || 10, steps: opened.steps, flow: opened.flow };
+    ed.from = null;  // a pull sets it again: the slot it came from
     ed.sel = 0;
     render();
     return wasLive ? '; live is now off, so the robot did not move (tick live to send the selected pose)' : '';
@@ -499,6 +517,7 @@ export function createEditor(root, ctx) {
       if (!mayReplace(`Pulling slot ${n}`)) return ctx.say('pull cancelled: the motion in the editor is kept');
       const r = await ctx.request({ op: 'motion_pull', slot: n });
       const note = load(r.motion);
+      ed.from = n;
       markClean();
       ctx.say(`motion ${r.slot} in the editor (${r.plays})` + (r.problem ? `; as it is, it would not push back: ${r.problem}` : '') + note);
     } catch (e) { ctx.say(e.message, 'error'); }
@@ -506,7 +525,13 @@ export function createEditor(root, ctx) {
   async function push() {
     try {
       const n = slotIn(); if (n === null) return;
+      // Another motion's slot is replaced only when the user says so (its bytes are backed up
+      // anyway); the slot this motion was pulled from or last pushed to is not asked about.
+      const held = (ctx.motions() ?? []).find((m) => m.slot === n);
+      if (held && n !== ed.from && !window.confirm(`Slot ${n} holds ${held.name ? `"${held.name}"` : 'a motion'}: Push replaces it with the motion in the editor (its bytes are backed up first). Push to slot ${n}?`))
+        return ctx.say(`push cancelled: slot ${n} is as it was`);
       const r = await ctx.request({ op: 'motion_push', slot: n, text: text() });
+      ed.from = n;
       const notes = r.notes?.length ? ` (${r.notes.join('; ')})` : '';
       markClean();
       ctx.say(r.unchanged ? `motion ${r.slot} already holds these ${r.bytes} bytes: nothing written${notes}`

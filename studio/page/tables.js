@@ -86,7 +86,7 @@ export function createTables(root, ctx) {
       el('td', { text: s.used ? (s.endless ? '∞' : s.calls ? 'calls' : s.seconds === null ? '–' : s.seconds.toFixed(2)) : '' }),
       el('td', {}, ...(s.used ? [
         bt('', '▶', 'play', () => ask({ op: 'motion_play', slot: s.slot }, `playing motion ${s.slot}`)),
-        bt('', '■', 'stop (every page may stop)', () => ask({ op: 'motion_stop' }, 'motion stopped'), ''),
+        bt('', '■', 'stop the motion and hold every joint where it is (every page may stop)', () => ctx.send({ op: 'motion_stop' }), ''),
         bt('', '✎', 'pull into the editor', () => ctx.edit(s.slot), ''),
         bt('', '✕', 'erase (asks first; its bytes backed up first)', () => {
           if (!window.confirm(`Erase motion ${s.slot}${s.name ? ` (${s.name})` : ''} from the board? Its bytes are backed up first.`)) return ctx.say('erase cancelled');

@@ -223,7 +223,14 @@ json board_loop::act(const motion_stop_action&) {
     }
     out["play_stopped"] = true;
   }
-  must(ops::stop_motion{}, "stop the motion");
+  insist([] { return ops::stop_motion{}; }, "stop the motion");
+  // The board's own stop lets the pose under way run on (up to 2.55 s): every joint holds where it
+  // is now, as the header's Stop does, so the robot stops when the button says so.
+  std::vector<const robot::joint*> all;
+  for (const auto& j : m_.joints()) all.push_back(&j);
+  const auto mask = mask_of(all, nullptr);
+  if (!mask.empty()) insist([&] { return ops::set_servo_power(ops::power_state::hold, mask); }, "hold");
+  out["held"] = all.size();
   return out;
 }
 

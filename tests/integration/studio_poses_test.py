@@ -272,9 +272,10 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(arrows == 2 and back == 1, f"two jump arrows, the loop drawn going back ({arrows}, {back})")
 
         # A block dragged somewhere else: moved, one undo step.
-        def block_xy(i):
+        def block_xy(i):  # in the flowchart's own coordinates (the page may scroll between two looks)
             return js(driver, """const r = document.querySelector(`#ed-flow .flow-block[data-step="${arguments[0]}"]`).getBoundingClientRect();
-                                 return [r.x, r.y];""", i)
+                                 const o = document.getElementById('ed-flow').getBoundingClientRect();
+                                 return [r.x - o.x, r.y - o.y];""", i)
         # (scrolled to where a user sees it: below the sticky robot panel, clear of the autoscroll edges)
         js(driver, """const b = document.querySelector('#ed-flow .flow-block[data-step="2"]');
                       window.scrollBy(0, b.getBoundingClientRect().top - window.innerHeight * 0.6);""")

@@ -115,6 +115,17 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         still_for(driver, 1.0, "Resume answered No")
         js(driver, "window.confirm = () => true")
 
+        # Stop motion in the middle of a ROM motion's pose: the pose does not run on (the board's own
+        # stop would let it finish, up to 2.55 s): every joint holds where it is at once.
+        js(driver, """[...document.querySelectorAll('#motions li[data-motion="12"] button')]
+                      .find((b) => b.textContent === 'Play').click()""")
+        check(wait_until(lambda: (state(driver, "motion") or {}).get("running"), timeout=5), "motion 12 plays again")
+        time.sleep(1.2)
+        click(driver, "motion-stop")
+        check(wait_until(lambda: "every joint holds where it is" in message(driver), timeout=5),
+              f"Stop motion in the middle of a pose: said ({message(driver)!r})")
+        still_for(driver, 1.5, "Stop motion during a ROM motion's pose")
+
         # 2. A motion played from the host: Free all, then Hold all, then Stop motion, each in its middle.
         js(driver, "document.querySelector('#ed-file').hidden = false")
         driver.find_element("id", "ed-file").send_keys(swing)
@@ -151,6 +162,32 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
               and (joint(driver, "left_hip_pitch"), joint(driver, "right_hip_pitch")) == hips
               and abs((joint(driver, "left_shoulder_pitch") or 0) - 60) < 1,
               f"Pull with live ticked: live off, the robot unmoved (hips {hips}, {message(driver)!r})")
+        # Live on again (the robot takes the bow's first pose), then Undo across the Pull: the other
+        # motion comes back, live goes off, and the robot stays in the bow's pose.
+        click(driver, "ed-live")
+        check(wait_until(lambda: abs((joint(driver, "left_hip_pitch") or 0) - 33.75) < 1, timeout=10),
+              "live on: the robot takes the bow's first pose")
+        click(driver, "ed-undo")
+        time.sleep(0.8)
+        check(not js(driver, "return document.getElementById('ed-live').checked")
+              and abs((joint(driver, "left_hip_pitch") or 0) - 33.75) < 1 and "live is now off" in message(driver),
+              f"Undo across a Pull with live ticked: live off, the robot unmoved ({message(driver)!r})")
+
+        # The slot box takes digits alone (+3 is no slot); Push over another motion's slot asks.
+        slot_box = driver.find_element("id", "ed-slot")
+        slot_box.clear()
+        slot_box.send_keys("+3")
+        click(driver, "ed-push")
+        check("digits only" in message(driver), f"'+3' as a slot: refused ({message(driver)!r})")
+        slot_box.clear()
+        slot_box.send_keys("3")
+        js(driver, "window.confirm = () => false")
+        click(driver, "ed-push")
+        check(wait_until(lambda: "push cancelled" in message(driver), timeout=5),
+              f"Push over slot 3 (the bow) asks first; No: nothing written ({message(driver)!r})")
+        js(driver, "window.confirm = () => true")
+        rc, out, err = run("--json", "--device", dev, "motion", "list")
+        check(rc == 0 and '"bow"' in out, f"slot 3 still holds the bow ({rc}: {out[:200]!r})")
 
         # 4. "play over" off the board's 10 ms period: refused on the page and by the server.
         box = driver.find_element("id", "pose-ms")
@@ -166,6 +203,19 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
             ".then(() => arguments[0]('played'), (e) => arguments[0](e.message))")
         check("not a whole number of this board's 10 ms output periods" in said,
               f"and by the server, whatever a page sends ({said!r})")
+
+        # 5. The robot's panel kept in view (the default) or scrolled away with the page, remembered;
+        # what is scrolled to lands below the panel while it is kept in view.
+        panel = "getComputedStyle(document.querySelector('.studio > .panel:first-child')).position"
+        pad = "parseFloat(document.documentElement.style.scrollPaddingTop)"
+        height = "document.querySelector('.studio > .panel:first-child').offsetHeight"
+        check(js(driver, f"return {panel}") == "sticky" and js(driver, f"return {pad}") > js(driver, f"return {height}"),
+              "the robot's panel is kept in view, and scrolling stops below it")
+        click(driver, "pin-robot")
+        check(js(driver, f"return {panel}") == "static" and js(driver, f"return {pad}") < js(driver, f"return {height}")
+              and js(driver, "return localStorage.getItem('rcb4-studio-unpinned')") == "1",
+              "unticked: it scrolls away with the page, and the browser remembers")
+        click(driver, "pin-robot")
     finally:
         driver.quit()
         rc = ui.stop()
