@@ -37,7 +37,9 @@ work = tempfile.mkdtemp(prefix="rcb4-ics-")
 os.chdir(work)
 
 with ics_serve() as pty:
-    rc, out, err = ics(pty, "scan", json_out=True)
+    # (the virtual servo is a process on a pty: under load, or under a sanitizer, its first answer
+    # can take longer than a real servo's 30 ms, so the scan waits longer here)
+    rc, out, err = ics(pty, "scan", "--scan-timeout", "300", json_out=True)
     servos = json.loads(out)["servos"] if rc == 0 else []
     check(rc == 0 and servos == [{"id": 0, "baud": 115200, "ics": "3.6", "stretch": 60, "speed": 127}],
           f"scan finds the servo: ID 0 at 115200, ICS 3.6 (rc {rc}: {out.strip()} {err.strip()})")
