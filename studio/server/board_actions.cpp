@@ -55,15 +55,20 @@ rcb4::servo_mask board_loop::mask_of(const std::vector<const robot::joint*>& joi
   return mask;
 }
 
-json board_loop::stop_motions_first() {
+json board_loop::stop_motions_first(bool rom_motion) {
   json out = json::object();
+  // A motion played from the host stops first: its next pose must not follow what comes next.
   if (studio_.playing()) {
     try {
       studio_.stop();
-    } catch (const std::exception&) {  // the board may not answer: the motion stop below is tried anyway
+    } catch (const std::exception&) {  // the board may not answer: what comes next is tried anyway
     }
     out["play_stopped"] = true;
   }
+  if (!rom_motion) return out;
+  // The state is read now, not taken from the last poll: a motion started since must stop too.
+  // Only a motion is stopped: with none (the program in its main loop) the program stays on, so
+  // the remote's buttons still play their motions.
   bool running = true;
   try {
     const auto st = must(ops::read_motion_state(*o_.layout), "read the motion state");
@@ -84,7 +89,7 @@ json board_loop::act(const power_action& a) {
   if (mask.empty()) throw refusal{"none of these joints has a servo block on the board (see rcb4 scan)"};
   // A motion's next pose would power the joints again (a free robot jerked back mid-fall), or move
   // held ones on: whatever plays stops first, and the answer says so.
-  json out = stop_motions_first();
+  json out = stop_motions_first(true);
   must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask), a.free ? "free" : "hold");
   out["joints"] = a.joints.size() - missing.size();
   out["missing"] = missing;
@@ -92,29 +97,8 @@ json board_loop::act(const power_action& a) {
 }
 
 json board_loop::act(const stop_action& a) {
-  json out;
-  // A motion played from the host stops first: its next pose must not follow the hold.
-  try {
-    studio_.stop();
-  } catch (const std::exception&) {  // the board may not answer: the hold below is tried anyway
-  }
-  // The state is read now, not taken from the last poll: a motion started since must stop too.
-  // Stopping it comes first (it would drive the joints again), then the hold.
-  if (a.motion) {
-    // Only a motion is stopped: with none (the program in its main loop) the program stays on, so
-    // the remote's buttons still play their motions.
-    bool running = true;
-    try {
-      const auto st = must(ops::read_motion_state(*o_.layout), "read the motion state");
-      running = st.running && st.motion;
-    } catch (const refusal&) {
-      // Unknown: stop it anyway.
-    }
-    if (running) {
-      insist([] { return ops::stop_motion{}; }, "stop the motion");
-      out["motion_stopped"] = true;
-    }
-  }
+  // Stopping a motion comes first (it would drive the joints again), then the hold.
+  json out = stop_motions_first(a.motion);
   const auto mask = mask_of(a.joints, nullptr);
   if (!mask.empty()) insist([&] { return ops::set_servo_power(ops::power_state::hold, mask); }, "hold");
   out["held"] = a.joints.size();
@@ -215,14 +199,7 @@ json board_loop::act(const motion_play_action& a) {
 }
 
 json board_loop::act(const motion_stop_action&) {
-  json out = json::object();
-  if (studio_.playing()) {  // a motion played from the host is a motion too: Stop motion stops it
-    try {
-      studio_.stop();
-    } catch (const std::exception&) {  // the board may not answer: the ROM's motion is stopped anyway
-    }
-    out["play_stopped"] = true;
-  }
+  json out = stop_motions_first(false);  // a motion played from the host is a motion too
   insist([] { return ops::stop_motion{}; }, "stop the motion");
   // The board's own stop lets the pose under way run on (up to 2.55 s): every joint holds where it
   // is now, as the header's Stop does, so the robot stops when the button says so.

@@ -100,8 +100,11 @@ class board_loop {
   rcb4::servo_mask mask_of(const std::vector<const joint*>& joints, std::vector<std::string>* missing);
   std::filesystem::path pose_path(const std::string& name, bool for_reading) const;
   json act(const power_action& a);
-  /** Stops a motion playing from the host and one of the ROM's, if any: what a free or hold needs first. */
-  json stop_motions_first();
+  /**
+   * Stops a motion playing from the host, and with @p rom_motion one of the ROM's if one runs:
+   * what a stop, a free or a hold needs first. Says which it stopped (play_stopped, motion_stopped).
+   */
+  json stop_motions_first(bool rom_motion);
   json act(const stop_action& a);
   json act(const capture_action& a);
   json act(const play_pose_action& a);
