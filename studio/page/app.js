@@ -422,6 +422,7 @@ async function buildStudio(h) {
     send,
     say,
     connected: () => ui.ws?.readyState === WebSocket.OPEN,
+    resume: () => resume(),
     view: null,
     measured: () => ({ ...ui.measured }),
     motions: () => ui.motions,
@@ -452,6 +453,20 @@ function selectJoint(name) {
   say(`${name} selected`);
 }
 
+/**
+ * Resume, from either of its buttons (the Motions panel's, the slot table's): asks first when a
+ * motion was stopped part way, since it runs on from where it stopped and the robot moves.
+ */
+function resume() {
+  const mo = ui.lastState?.motion, free = (ui.lastState?.modes ?? []).filter((x) => x === 'free').length;
+  if (mo?.suspended && mo.slot && !window.confirm(`Motion ${mo.slot} of the ROM (its slot, not a play from the editor) was stopped part way: `
+    + 'Resume runs it on from where it stopped (the pose that was under way is not played again), and the robot moves'
+    + (free ? `; the ${free} servos that are free now are powered again by its next pose` : '') + '. Resume it?'))
+    return say('resume cancelled: the ROM program stays stopped');
+  request({ op: 'motion_resume' }).then(() => say(mo?.suspended && mo.slot ? `motion ${mo.slot} runs on from where it stopped` : 'the ROM program runs again'),
+    (e) => say(e.message, 'error'));
+}
+
 // --- the buttons ----------------------------------------------------------------------------------------
 
 function wire() {
@@ -467,15 +482,7 @@ function wire() {
   $('#motion-stop').addEventListener('click', () => send({ op: 'motion_stop' }));
   // Resume runs the ROM program on from where it stopped: a motion stopped part way goes on, and
   // the robot moves. Asked first then (a user who wants the buttons back may not expect it).
-  $('#motions-resume').addEventListener('click', () => {
-    const mo = ui.lastState?.motion, free = (ui.lastState?.modes ?? []).filter((x) => x === 'free').length;
-    if (mo?.suspended && mo.slot && !window.confirm(`Motion ${mo.slot} of the ROM (its slot, not a play from the editor) was stopped part way: `
-      + 'Resume runs it on from where it stopped (the pose that was under way is not played again), and the robot moves'
-      + (free ? `; the ${free} servos that are free now are powered again by its next pose` : '') + '. Resume it?'))
-      return say('resume cancelled: the ROM program stays stopped');
-    request({ op: 'motion_resume' }).then(() => say(mo?.suspended && mo.slot ? `motion ${mo.slot} runs on from where it stopped` : 'the ROM program runs again'),
-      (e) => say(e.message, 'error'));
-  });
+  $('#motions-resume').addEventListener('click', () => resume());
   $('#refresh').addEventListener('click', () => send({ op: 'refresh' }));
   $('#capture-form').addEventListener('submit', (ev) => {
     ev.preventDefault();

@@ -38,7 +38,7 @@ export function createTables(root, ctx) {
   root.replaceChildren(
     el('details', { open: true, id: 'slots-panel' }, el('summary', {}, 'Motion slots'),
       el('div', { class: 'row' }, bt('slots-refresh', 'Refresh', 'read the 120 slots again', () => list(), ''),
-        bt('motion-resume', 'Resume', 'let a motion stopped part way go on', () => ask({ op: 'motion_resume' }, 'the ROM program runs again'))),
+        bt('motion-resume', 'Resume', 'let a motion stopped part way go on (asks first)', () => ctx.resume())),
       el('div', { class: 'slots-box' }, el('table', { class: 'slots' },
         el('thead', {}, el('tr', {}, ...['slot', 'name', 'bytes', 's', ''].map((t) => el('th', { text: t })))), tbody))),
     el('details', { id: 'buttons-panel' }, el('summary', {}, 'Remote buttons'), pad,

@@ -90,6 +90,9 @@ json board_loop::act(const power_action& a) {
   // A motion's next pose would power the joints again (a free robot jerked back mid-fall), or move
   // held ones on: whatever plays stops first, and the answer says so.
   json out = stop_motions_first(true);
+  // The board's stop lets the pose under way run on: with a ROM motion stopped, every joint holds
+  // where it is first, so the joints not named stop too (a host play's stop holds them itself).
+  if (out.contains("motion_stopped")) hold_all();
   must(ops::set_servo_power(a.free ? ops::power_state::free : ops::power_state::hold, mask), a.free ? "free" : "hold");
   out["joints"] = a.joints.size() - missing.size();
   out["missing"] = missing;
@@ -203,12 +206,16 @@ json board_loop::act(const motion_stop_action&) {
   insist([] { return ops::stop_motion{}; }, "stop the motion");
   // The board's own stop lets the pose under way run on (up to 2.55 s): every joint holds where it
   // is now, as the header's Stop does, so the robot stops when the button says so.
+  out["held"] = hold_all();
+  return out;
+}
+
+std::size_t board_loop::hold_all() {
   std::vector<const robot::joint*> all;
   for (const auto& j : m_.joints()) all.push_back(&j);
   const auto mask = mask_of(all, nullptr);
   if (!mask.empty()) insist([&] { return ops::set_servo_power(ops::power_state::hold, mask); }, "hold");
-  out["held"] = all.size();
-  return out;
+  return all.size();
 }
 
 json board_loop::act(const refresh_action&) {

@@ -105,6 +105,8 @@ class board_loop {
    * what a stop, a free or a hold needs first. Says which it stopped (play_stopped, motion_stopped).
    */
   json stop_motions_first(bool rom_motion);
+  /** Every joint of the robot holds where it is (insisted on); returns how many joints. */
+  std::size_t hold_all();
   json act(const stop_action& a);
   json act(const capture_action& a);
   json act(const play_pose_action& a);

@@ -19,16 +19,17 @@ from uihelp import tools
 RCB4 = sys.argv[1]
 run, serve, Ui, browser, wait_until, joints_on = tools(RCB4)
 
-# A motion long enough to act in the middle of: the left shoulder's pitch 60, -60, 60, 2.55 s each.
+# A motion long enough to act in the middle of: the shoulders' pitch 60, -60, 60 (the right one the
+# other way), 2.55 s each.
 LONG = """robot: KHR-3HV
 name: swing
 period_ms: 10
 steps:
-  - pose: {left_shoulder_pitch: 60}
+  - pose: {left_shoulder_pitch: 60, right_shoulder_pitch: -60}
     time_ms: 2550
-  - pose: {left_shoulder_pitch: -60}
+  - pose: {left_shoulder_pitch: -60, right_shoulder_pitch: 60}
     time_ms: 2550
-  - pose: {left_shoulder_pitch: 60}
+  - pose: {left_shoulder_pitch: 60, right_shoulder_pitch: -60}
     time_ms: 2550
   - end
 """
@@ -113,6 +114,11 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
               and (state(driver, "motion") or {}).get("suspended") and not (state(driver, "motion") or {}).get("running"),
               f"Resume after a motion stopped part way asks; No: it stays stopped ({message(driver)!r})")
         still_for(driver, 1.0, "Resume answered No")
+        click(driver, "motion-resume")  # the slot table's Resume: the same question
+        check(wait_until(lambda: "resume cancelled" in message(driver), timeout=5)
+              and not (state(driver, "motion") or {}).get("running"),
+              f"the slot table's Resume asks too; No: it stays stopped ({message(driver)!r})")
+        still_for(driver, 1.0, "the table's Resume answered No")
         js(driver, "window.confirm = () => true")
 
         # Stop motion in the middle of a ROM motion's pose: the pose does not run on (the board's own
@@ -125,6 +131,22 @@ with serve() as dev, tempfile.TemporaryDirectory() as poses:
         check(wait_until(lambda: "every joint holds where it is" in message(driver), timeout=5),
               f"Stop motion in the middle of a pose: said ({message(driver)!r})")
         still_for(driver, 1.5, "Stop motion during a ROM motion's pose")
+
+        # One joint freed in the middle of a ROM motion's pose: the motion stops, and the joints not
+        # named hold where they are (the right shoulder was swinging the other way).
+        js(driver, """[...document.querySelectorAll('#motions li[data-motion="12"] button')]
+                      .find((b) => b.textContent === 'Play').click()""")
+        check(wait_until(lambda: (state(driver, "motion") or {}).get("running"), timeout=5), "motion 12 plays again")
+        time.sleep(1.2)
+        said = driver.execute_async_script(
+            "window.rcb4Studio.request({op: 'free', joints: ['left_shoulder_pitch']})"
+            ".then((r) => arguments[0](JSON.stringify(r)), (e) => arguments[0](e.message))")
+        check('"motion_stopped":true' in said, f"the left shoulder freed: the motion stopped first ({said})")
+        still_for(driver, 1.5, "one joint freed during a ROM motion's pose")
+        check(joint(driver, "right_shoulder_pitch", "targets") is None or "hold" == state(driver, "modes")[NAMES.index("right_shoulder_pitch")],
+              f"the right shoulder holds ({state(driver, 'modes')[NAMES.index('right_shoulder_pitch')]})")
+        click(driver, "hold-all")
+        wait_until(lambda: "free" not in (state(driver, "modes") or ["free"]), timeout=5)
 
         # 2. A motion played from the host: Free all, then Hold all, then Stop motion, each in its middle.
         js(driver, "document.querySelector('#ed-file').hidden = false")
