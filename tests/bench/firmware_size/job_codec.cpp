@@ -3,38 +3,9 @@
 // one CONST. Every reply is checked (its size, checksum, kind and length: parse_reply with the
 // command's expected shape); a reply that does not come within 100 ms fails the job.
 // SPDX-License-Identifier: BSL-1.0
-#include <rcb4/rcb4.hpp>
+#include "exchange.hpp"
 
-#include "uart.hpp"
-
-#include <array>
-
-namespace {
-
-std::array<std::uint8_t, rcb4::max_reply_size> g_rx{};  // the reply (a data reply refers to it)
-
-/** Sends @p c and reads its reply: the reply when it came whole and valid, else the error. */
-template <rcb4::Command C>
-rcb4::result<rcb4::reply> exchange(const C& c) noexcept {
-  std::array<std::uint8_t, rcb4::max_request_size> tx{};
-  const auto n = rcb4::serialize(c, tx);
-  if (!n) return n.error();
-  for (std::size_t i = 0; i < *n; ++i) bench::uart_put(tx[i]);
-  const std::uint32_t deadline = bench::now_ms() + 100;
-  std::size_t got = 0;
-  for (;;) {
-    const auto p = rcb4::parse_reply({g_rx.data(), got}, c.expected_reply());
-    if (p.ok()) return p.value();
-    if (p.status == rcb4::parse_status::error) return p.error;
-    for (std::size_t k = 0; k < p.needed; ++k) {
-      const int b = bench::uart_get(deadline);
-      if (b < 0) return rcb4::errc::link_timeout;
-      g_rx[got++] = static_cast<std::uint8_t>(b);
-    }
-  }
-}
-
-}  // namespace
+using bench::exchange;
 
 int main() {
   using namespace rcb4;

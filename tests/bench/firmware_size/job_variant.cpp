@@ -1,36 +1,9 @@
 // The firmware-size bench's job (job_codec.cpp) with each command passed as the `rcb4::command`
 // variant, as the operations and the transport take it today: what the variant costs an image.
 // SPDX-License-Identifier: BSL-1.0
-#include <rcb4/rcb4.hpp>
+#include "exchange.hpp"
 
-#include "uart.hpp"
-
-#include <array>
-
-namespace {
-
-std::array<std::uint8_t, rcb4::max_reply_size> g_rx{};
-
-rcb4::result<rcb4::reply> exchange(const rcb4::command& c) noexcept {
-  std::array<std::uint8_t, rcb4::max_request_size> tx{};
-  const auto n = rcb4::serialize(c, tx);
-  if (!n) return n.error();
-  for (std::size_t i = 0; i < *n; ++i) bench::uart_put(tx[i]);
-  const std::uint32_t deadline = bench::now_ms() + 100;
-  std::size_t got = 0;
-  for (;;) {
-    const auto p = rcb4::parse_reply({g_rx.data(), got}, rcb4::expected_reply(c));
-    if (p.ok()) return p.value();
-    if (p.status == rcb4::parse_status::error) return p.error;
-    for (std::size_t k = 0; k < p.needed; ++k) {
-      const int b = bench::uart_get(deadline);
-      if (b < 0) return rcb4::errc::link_timeout;
-      g_rx[got++] = static_cast<std::uint8_t>(b);
-    }
-  }
-}
-
-}  // namespace
+using bench::exchange;
 
 int main() {
   using namespace rcb4;
