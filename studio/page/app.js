@@ -326,14 +326,21 @@ async function insertPose(name) {
   }
 }
 
+/**
+ * "play over"'s check: whole periods of the board's output period (the state says it; 10 ms until
+ * the first state), 255 of them at most (the server stretches the time to the speed limit).
+ */
+function playOverCheck() {
+  const period = ui.lastState?.output_period_ms || 10;
+  return { min: period, max: 255 * period, whole: true, multipleOf: period, what: 'play over', unit: ' ms' };
+}
+
 function playPose(name) {
   // the time the pose is played over: checked, never coerced (letters are no 0 ms snap)
-  // whole periods of the board's output period (the state says it), 255 of them at most; the
-  // server stretches it to the speed limit
-  const box = $('#pose-ms'), period = ui.lastState?.output_period_ms || 10, most = 255 * period;
-  box.numberCheck = { min: period, max: most, whole: true, multipleOf: period, what: 'play over', unit: ' ms' };
+  const box = $('#pose-ms');
+  box.numberCheck = playOverCheck();
   const r = numberIn(box);
-  if (r.value === null) return say(r.why || `play over: type a time in ms (${period} to ${most})`, 'error');
+  if (r.value === null) return say(r.why || `play over: type a time in ms (${box.numberCheck.min} to ${box.numberCheck.max})`, 'error');
   send({ op: 'play_pose', name, ms: r.value });
 }
 
@@ -498,8 +505,8 @@ function wire() {
 
 wire();
 // "play over" is marked or cleared as typed, like every number box (its check: playPose()).
-$('#pose-ms').numberCheck = { min: 10, max: 2550, whole: true, multipleOf: 10, what: 'play over', unit: ' ms' };
-$('#pose-ms').addEventListener('input', (e) => numberIn(e.target));
+$('#pose-ms').numberCheck = playOverCheck();
+$('#pose-ms').addEventListener('input', (e) => { e.target.numberCheck = playOverCheck(); numberIn(e.target); });
 
 // The robot's panel sticks below the header (style.css), whose height depends on the window. What
 // is scrolled to (a focused box, a selected step) lands below both, never under the robot's panel.
